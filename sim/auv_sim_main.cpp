@@ -1,0 +1,73 @@
+// auv_sim: serves K simulated vehicles over the transport (lockstep or real time), or runs the
+// open-loop validation tool. Parses the command line and wires library pieces; nothing else.
+#include <iostream>
+
+#include "common/cli.hpp"
+#include "common/signals.hpp"
+#include "common/transport.hpp"
+#include "sim/open_loop.hpp"
+#include "sim/sim_server.hpp"
+
+int main(int argc, char** argv) {
+  using namespace auvrl;
+  std::string vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+  sim::SimServerConfig server;
+  transport::TransportConfig transport_config;
+  bool realtime = false;
+  std::string open_loop_in, open_loop_out;
+  bool ideal_thrusters = false;
+
+  cli::CommandLine cmd("auv_sim",
+                       "Simulates K vehicles served over LCM (lockstep for training, real time for "
+                       "demos), or runs thrust commands open loop from a CSV file.");
+  cmd.option("vehicle", &vehicle_path, "vehicle file (YAML)");
+  cmd.option("vehicles", &server.num_vehicles, "number of vehicles K (ids 0..K-1)");
+  cmd.flag("realtime", &realtime, "step at wall-clock rate with the latest command");
+  cmd.option("realtime-factor", &server.realtime_factor, "real-time mode: sim seconds per second");
+  cmd.option("heartbeat-period", &server.heartbeat_period_s, "heartbeat period, s");
+  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.flag("allow-off-host", &transport_config.allow_off_host,
+           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  cmd.option("open-loop", &open_loop_in, "open-loop tool: input CSV t,f1..fN (N)");
+  cmd.option("out", &open_loop_out, "open-loop tool: output CSV");
+  cmd.flag("ideal-thrusters", &ideal_thrusters, "open-loop tool: no thruster delay, lag or slew");
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+  } catch (const cli::UsageError& e) {
+    std::cerr << "auv_sim: " << e.what() << "\n";
+    return 2;
+  }
+
+  if (!open_loop_in.empty() || !open_loop_out.empty()) {
+    if (open_loop_in.empty() || open_loop_out.empty()) {
+      std::cerr << "auv_sim: --open-loop and --out go together\n";
+      return 2;
+    }
+    sim::OpenLoopOptions options;
+    options.vehicle_path = vehicle_path;
+    options.input_csv = open_loop_in;
+    options.output_csv = open_loop_out;
+    options.ideal_thrusters = ideal_thrusters;
+    return sim::run_open_loop(options, std::cerr);
+  }
+
+  try {
+    const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path);
+    server.lockstep = !realtime;
+    server.vehicle_file = vehicle_path;
+    auto transport = transport::make_transport(transport_config);
+    signals::install_stop_handlers();
+    sim::SimServer sim_server(model, *transport, server);
+    std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " ("
+              << vehicle_path << "), " << (realtime ? "real time" : "lockstep") << ", "
+              << transport_config.lcm_url << "\n";
+    sim_server.run([] { return signals::stop_requested(); });
+    const auto counters = sim_server.counters();
+    std::cerr << "auv_sim: stopped after " << counters.steps_total << " steps, "
+              << counters.resets_total << " resets\n";
+  } catch (const std::exception& e) {
+    std::cerr << "auv_sim: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,124 @@
+// The immutable description of a vehicle (MuJoCo's mjModel): rigid body, hydrodynamics,
+// hydrostatics, thrusters and integrator settings, loaded and validated from a YAML file.
+#pragma once
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace auvrl::sim {
+
+/// Most thrusters a vehicle file may declare; bounds the fixed-capacity thrust vectors so the
+/// physics step never allocates.
+inline constexpr int kMaxThrusters = 12;
+
+using Vector3 = Eigen::Vector3d;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using Matrix3 = Eigen::Matrix3d;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+/// Per-thruster quantities (N or unitless); size = number of thrusters, capacity kMaxThrusters.
+using ThrusterVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxThrusters, 1>;
+/// Thruster allocation matrix B (6 x n): tau_body = B * thrust_n, rows X, Y, Z, K, M, N.
+using AllocationMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxThrusters>;
+
+/// Error in a vehicle file: names the file and the field and says what was expected.
+class VehicleFileError : public std::runtime_error {
+ public:
+  VehicleFileError(const std::string& file, const std::string& field, const std::string& what)
+      : std::runtime_error(file + ": field '" + field + "': " + what), file_(file), field_(field) {}
+  const std::string& file() const { return file_; }
+  const std::string& field() const { return field_; }
+
+ private:
+  std::string file_;
+  std::string field_;
+};
+
+/// One thruster: where it sits and which way it pushes, in the body frame.
+struct Thruster {
+  std::string name;
+  Vector3 position_body_m = Vector3::Zero();  ///< from the body origin (= centre of buoyancy)
+  Vector3 direction_body = Vector3::UnitX();  ///< unit vector of positive thrust
+};
+
+/// Thruster response as identified on the real vehicle; each effect can be switched off.
+struct ThrusterDynamics {
+  double max_thrust_n = 39.24;        ///< symmetric saturation |f| <= max, per thruster
+  bool delay_enabled = true;          ///< one control-step (sample) delay of the command
+  bool lag_enabled = true;            ///< first-order low-pass on the realised thrust
+  double lag_time_constant_s = 0.29;  ///< time constant of that low-pass
+  bool slew_enabled = true;           ///< rate limit on the realised thrust
+  double slew_rate_n_per_s = 21.6;    ///< 5.5 % of full throttle per 0.1 s, in N/s
+};
+
+/// Integration scheme for one control step.
+enum class Integrator { kRk4, kSemiImplicitEuler };
+
+/// Limits beyond which the state is declared blown up (reported, never propagated).
+struct BlowUpLimits {
+  double max_linear_speed_mps = 20.0;
+  double max_angular_rate_rad_s = 20.0;
+  double max_position_m = 1.0e4;
+};
+
+/// The whole vehicle model. Immutable once loaded; derived matrices are precomputed.
+struct VehicleModel {
+  std::string name;
+  std::string source_file;
+
+  // Rigid body.
+  double mass_kg = 0;
+  double weight_n = 0;    ///< W = m g
+  double buoyancy_n = 0;  ///< B = rho g V
+  Vector3 cog_body_m = Vector3::Zero();  ///< centre of gravity r_g
+  Vector3 cob_body_m = Vector3::Zero();  ///< centre of buoyancy r_b
+  Matrix3 inertia_kg_m2 = Matrix3::Zero();  ///< about the body origin's axes, at the CG
+
+  // Hydrodynamics (SNAME signs: added-mass and damping derivatives are negative numbers).
+  Vector6 added_mass_derivatives = Vector6::Zero();  ///< [X_udot Y_vdot Z_wdot K_pdot M_qdot N_rdot]
+  Vector6 linear_damping = Vector6::Zero();     ///< [X_u Y_v Z_w K_p M_q N_r], <= 0
+  Vector6 quadratic_damping = Vector6::Zero();  ///< [X_uu Y_vv Z_ww K_pp M_qq N_rr], <= 0
+  bool added_mass_coriolis = false;             ///< include C_A(nu_r) (Munk moment)
+
+  // Thrusters.
+  std::vector<Thruster> thrusters;
+  AllocationMatrix allocation;  ///< column i = [d_i; r_i x d_i]
+  ThrusterDynamics thruster_dynamics;
+
+  // Integration.
+  double control_step_s = 0.1;
+  Integrator integrator = Integrator::kRk4;
+  int substeps = 10;  ///< integrator steps per control step
+  BlowUpLimits blow_up;
+
+  // Derived at load time.
+  Matrix6 mass_rigid_body = Matrix6::Zero();  ///< M_RB with the CG offset
+  Matrix6 mass_added = Matrix6::Zero();       ///< M_A = -diag(added_mass_derivatives)
+  Matrix6 mass_total = Matrix6::Zero();       ///< M = M_RB + M_A
+  Matrix6 mass_total_inverse = Matrix6::Zero();
+
+  int num_thrusters() const { return static_cast<int>(thrusters.size()); }
+};
+
+/// Singular values of the allocation matrix below this do not count as control authority. The
+/// unit is N (or N m) of generalised force per N of thrust along a unit-norm thrust vector:
+/// 0.1 is a 10 cm lever arm. Nessie VII's lateral thrusters sit about 5 cm above and below the
+/// centre of buoyancy, so its roll authority falls under it: five controllable DOF.
+inline constexpr double kAllocationMinSingularValue = 0.1;
+/// Fewest controllable DOF a vehicle file may have (a layout with less is rejected).
+inline constexpr int kMinControllableDof = 5;
+
+/// Number of singular values of the allocation matrix at or above kAllocationMinSingularValue:
+/// how many independent body-frame DOF the thrusters can drive.
+int allocation_rank(const AllocationMatrix& allocation);
+
+/// Loads and validates a vehicle file; throws VehicleFileError naming file and field.
+VehicleModel load_vehicle_file(const std::string& path);
+
+/// Fills the derived members (allocation, mass matrices) and validates the whole model;
+/// throws VehicleFileError with model.source_file. Called by load_vehicle_file; public so
+/// tests and tools can build a model in code.
+void finalize_vehicle_model(VehicleModel& model);
+
+}  // namespace auvrl::sim
