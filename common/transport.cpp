@@ -2,6 +2,7 @@
 
 #include <lcm/lcm.h>
 
+#include <cerrno>
 #include <chrono>
 #include <map>
 #include <regex>
@@ -75,7 +76,10 @@ class LcmTransport final : public Transport {
   }
 
   bool handle_one(int timeout_ms) override {
+    errno = 0;
     const int status = lcm_handle_timeout(lcm_, timeout_ms);
+    // A signal (SIGTERM for a clean stop) interrupts the wait: not a failure.
+    if (status < 0 && errno == EINTR) return false;
     if (status < 0) throw TransportError("LCM receive failed on " + url_);
     return status > 0;
   }

@@ -181,6 +181,18 @@ void SimServer::on_command(const std::string& channel, const auvrl_lcm::thruster
     ++counters_.dropped_not_reset;
     return;
   }
+  // Sequence numbers make lockstep retries safe: a repeat gets the same answer again
+  // instead of a second step; an older command is a leftover and is ignored.
+  if (msg.seq == vehicle->last_seq) {
+    ++counters_.duplicates_answered;
+    transport_.publish(channels::sim_state(msg.vehicle_id), vehicle->last_state_bytes.data(),
+                       vehicle->last_state_bytes.size());
+    return;
+  }
+  if (msg.seq < vehicle->last_seq) {
+    ++counters_.dropped_stale;
+    return;
+  }
   vehicle->last_seq = msg.seq;
   const ThrusterVector command_n =
       Eigen::Map<const Eigen::VectorXd>(msg.thrust_n.data(), msg.num_thrusters);
@@ -242,9 +254,10 @@ void SimServer::publish_state(int id, Vehicle& vehicle) {
   const Measurement measurement = measure(model_, vehicle.state);
   state_message_from_measurement(measurement, vehicle.state, id, vehicle.last_seq, state_msg_);
   const int size = state_msg_.getEncodedSize();
-  encode_buffer_.resize(static_cast<std::size_t>(size));
-  state_msg_.encode(encode_buffer_.data(), 0, size);
-  transport_.publish(channels::sim_state(id), encode_buffer_.data(), encode_buffer_.size());
+  vehicle.last_state_bytes.resize(static_cast<std::size_t>(size));
+  state_msg_.encode(vehicle.last_state_bytes.data(), 0, size);
+  transport_.publish(channels::sim_state(id), vehicle.last_state_bytes.data(),
+                     vehicle.last_state_bytes.size());
 }
 
 void SimServer::realtime_tick() {
@@ -292,6 +305,8 @@ void SimServer::publish_heartbeat() {
   hb.resets_total = counters_.resets_total;
   hb.faults_total = counters_.faults_total;
   hb.blow_ups_total = counters_.blow_ups_total;
+  hb.duplicates_answered = counters_.duplicates_answered;
+  hb.dropped_stale = counters_.dropped_stale;
   hb.dropped_decode = decode_stats_.failed;
   hb.dropped_vehicle_id = counters_.dropped_vehicle_id;
   hb.dropped_thrusters = counters_.dropped_thrusters;

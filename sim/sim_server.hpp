@@ -33,11 +33,13 @@ struct SimServerCounters {
   std::int64_t resets_total = 0;
   std::int64_t faults_total = 0;
   std::int64_t blow_ups_total = 0;
+  std::int64_t duplicates_answered = 0;
   std::int64_t dropped_decode = 0;
   std::int64_t dropped_vehicle_id = 0;
   std::int64_t dropped_thrusters = 0;
   std::int64_t dropped_non_finite = 0;
   std::int64_t dropped_out_of_range = 0;
+  std::int64_t dropped_stale = 0;
   std::int64_t dropped_not_reset = 0;
 };
 
@@ -84,6 +86,7 @@ class SimServer {
     VehicleState state;
     ThrusterVector held_command_n;  ///< real-time mode: latest command
     std::int64_t last_seq = 0;
+    std::vector<std::uint8_t> last_state_bytes;  ///< re-sent when a command is repeated
   };
 
   void on_command(const std::string& channel, const auvrl_lcm::thruster_cmd_t& msg);
@@ -107,7 +110,6 @@ class SimServer {
   transport::DecodeStats decode_stats_;
   std::vector<transport::SubscriptionId> subscriptions_;
   auvrl_lcm::vehicle_state_t state_msg_;  ///< reused to avoid allocation per step
-  std::vector<std::uint8_t> encode_buffer_;
   std::chrono::steady_clock::time_point next_heartbeat_;
   std::chrono::steady_clock::time_point next_realtime_step_;
   std::chrono::steady_clock::time_point rate_window_start_;

@@ -1,0 +1,98 @@
+// Lockstep control steps per second over LCM: auv_sim as a real process, one client, then two
+// client processes at once, each driving its own vehicle. Prints one line per case:
+//   lockstep clients=1 steps=N steps_per_s=X p50_us=.. p99_us=..
+// Run it inside a private network namespace: scripts/netns.sh build/bin/bench_lockstep
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <thread>
+
+#include "child_process.hpp"
+#include "common/cli.hpp"
+#include "common/sim_client.hpp"
+
+namespace {
+
+using namespace auvrl;
+using Clock = std::chrono::steady_clock;
+
+struct ClientResult {
+  double steps_per_s = 0;
+  double p50_us = 0;
+  double p99_us = 0;
+  int failures = 0;
+};
+
+ClientResult run_client(int vehicle_id, int steps) {
+  auto transport = transport::make_transport({});
+  SimClient client(*transport, vehicle_id);
+  auvrl_lcm::vehicle_reset_t reset{};
+  reset.position_ned_m[2] = 5.0;
+  ClientResult result;
+  // auv_sim may still be starting: retry the reset for a few seconds.
+  bool ready = false;
+  for (int i = 0; i < 50 && !ready; ++i) ready = client.reset(reset).has_value();
+  if (!ready) {
+    result.failures = steps;
+    return result;
+  }
+  std::vector<double> command(6, 5.0);
+  std::vector<double> latency_us;
+  latency_us.reserve(static_cast<std::size_t>(steps));
+  const auto start = Clock::now();
+  for (int k = 0; k < steps; ++k) {
+    command[0] = (k % 100) * 0.3;
+    const auto t0 = Clock::now();
+    if (!client.step(command)) ++result.failures;
+    latency_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  std::sort(latency_us.begin(), latency_us.end());
+  result.steps_per_s = steps / seconds;
+  result.p50_us = latency_us[latency_us.size() / 2];
+  result.p99_us = latency_us[latency_us.size() * 99 / 100];
+  return result;
+}
+
+void print(int clients, int index, int steps, const ClientResult& r) {
+  std::printf("lockstep clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f p99_us=%.1f "
+              "failures=%d\n",
+              clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int steps = 20000;
+  std::string vehicle = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+  cli::CommandLine cmd("bench_lockstep", "Lockstep steps/s over LCM with one and two clients.");
+  cmd.option("steps", &steps, "steps per client");
+  cmd.option("vehicle", &vehicle, "vehicle file");
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+  } catch (const cli::UsageError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  }
+  test_support::ChildProcess sim({test_support::bin_path("auv_sim"), "--vehicle", vehicle, "--vehicles",
+                             "2"});
+  print(1, 0, steps, run_client(0, steps));
+
+  // Two client processes at once, each on its own vehicle; each prints its own line.
+  std::vector<pid_t> children;
+  for (int id = 0; id < 2; ++id) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      print(2, id, steps, run_client(id, steps));
+      _exit(0);
+    }
+    children.push_back(pid);
+  }
+  for (pid_t pid : children) waitpid(pid, nullptr, 0);
+  return 0;
+}
