@@ -110,7 +110,11 @@ SimServer::SimServer(const VehicleModel& model, transport::Transport& transport,
   if (config_.num_vehicles < 1) throw std::invalid_argument("num_vehicles must be >= 1");
   if (!(config_.realtime_factor > 0)) throw std::invalid_argument("realtime_factor must be > 0");
   vehicles_.resize(static_cast<std::size_t>(config_.num_vehicles));
-  for (Vehicle& v : vehicles_) v.held_command_n = ThrusterVector::Zero(model_.num_thrusters());
+  for (int id = 0; id < config_.num_vehicles; ++id) {
+    Vehicle& v = vehicles_[static_cast<std::size_t>(id)];
+    v.held_command_n = ThrusterVector::Zero(model_.num_thrusters());
+    v.state_channel = channels::sim_state(id);
+  }
 
   using transport::subscribe;
   subscriptions_.push_back(subscribe<auvrl_lcm::thruster_cmd_t>(
@@ -185,7 +189,7 @@ void SimServer::on_command(const std::string& channel, const auvrl_lcm::thruster
   // instead of a second step; an older command is a leftover and is ignored.
   if (msg.seq == vehicle->last_seq) {
     ++counters_.duplicates_answered;
-    transport_.publish(channels::sim_state(msg.vehicle_id), vehicle->last_state_bytes.data(),
+    transport_.publish(vehicle->state_channel, vehicle->last_state_bytes.data(),
                        vehicle->last_state_bytes.size());
     return;
   }
@@ -256,7 +260,7 @@ void SimServer::publish_state(int id, Vehicle& vehicle) {
   const int size = state_msg_.getEncodedSize();
   vehicle.last_state_bytes.resize(static_cast<std::size_t>(size));
   state_msg_.encode(vehicle.last_state_bytes.data(), 0, size);
-  transport_.publish(channels::sim_state(id), vehicle.last_state_bytes.data(),
+  transport_.publish(vehicle.state_channel, vehicle.last_state_bytes.data(),
                      vehicle.last_state_bytes.size());
 }
 

@@ -87,6 +87,7 @@ class SimServer {
     ThrusterVector held_command_n;  ///< real-time mode: latest command
     std::int64_t last_seq = 0;
     std::vector<std::uint8_t> last_state_bytes;  ///< re-sent when a command is repeated
+    std::string state_channel;                   ///< SIM_STATE_<id>, built once
   };
 
   void on_command(const std::string& channel, const auvrl_lcm::thruster_cmd_t& msg);

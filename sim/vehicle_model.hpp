@@ -69,14 +69,15 @@ struct VehicleModel {
 
   // Rigid body.
   double mass_kg = 0;
-  double weight_n = 0;    ///< W = m g
-  double buoyancy_n = 0;  ///< B = rho g V
-  Vector3 cog_body_m = Vector3::Zero();  ///< centre of gravity r_g
-  Vector3 cob_body_m = Vector3::Zero();  ///< centre of buoyancy r_b
+  double weight_n = 0;                      ///< W = m g
+  double buoyancy_n = 0;                    ///< B = rho g V
+  Vector3 cog_body_m = Vector3::Zero();     ///< centre of gravity r_g
+  Vector3 cob_body_m = Vector3::Zero();     ///< centre of buoyancy r_b
   Matrix3 inertia_kg_m2 = Matrix3::Zero();  ///< about the body origin's axes, at the CG
 
   // Hydrodynamics (SNAME signs: added-mass and damping derivatives are negative numbers).
-  Vector6 added_mass_derivatives = Vector6::Zero();  ///< [X_udot Y_vdot Z_wdot K_pdot M_qdot N_rdot]
+  Vector6 added_mass_derivatives =
+      Vector6::Zero();                          ///< [X_udot Y_vdot Z_wdot K_pdot M_qdot N_rdot]
   Vector6 linear_damping = Vector6::Zero();     ///< [X_u Y_v Z_w K_p M_q N_r], <= 0
   Vector6 quadratic_damping = Vector6::Zero();  ///< [X_uu Y_vv Z_ww K_pp M_qq N_rr], <= 0
   bool added_mass_coriolis = false;             ///< include C_A(nu_r) (Munk moment)
