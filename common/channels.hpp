@@ -16,6 +16,19 @@ inline std::string sim_fault(int vehicle_id) { return "SIM_FAULT_" + std::to_str
 /// auv_sim's heartbeat (sim_heartbeat_t).
 inline const std::string kSimHeartbeat = "SIM_HEARTBEAT";
 
+/// Actors' transitions for the learner (experience_batch_t).
+inline const std::string kExperience = "EXPERIENCE";
+/// The learner's actor network (policy_weights_t, large) and its small companion
+/// (policy_summary_t, same version).
+inline const std::string kPolicyWeights = "POLICY_WEIGHTS";
+inline const std::string kPolicySummary = "POLICY_SUMMARY";
+/// An actor asks for the current weights (weights_request_t).
+inline const std::string kWeightsRequest = "WEIGHTS_REQUEST";
+/// The learner's figures (learner_stats_t).
+inline const std::string kLearnerStats = "LEARNER_STATS";
+/// One finished episode of an actor (episode_report_t).
+inline const std::string kEpisode = "EPISODE";
+
 /// Regexes auv_sim subscribes to (all vehicle ids; the id is parsed and checked).
 inline const std::string kSimCommandPattern = "SIM_CMD_[0-9]+";
 inline const std::string kSimResetPattern = "SIM_RESET_[0-9]+";

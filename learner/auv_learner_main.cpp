@@ -1,0 +1,154 @@
+// auv_learner: the central learner (replay buffer, networks, DDPG/TD3 updates, weights
+// broadcast, schedule, checkpoints), or `--bench` to print update rates. Parses the command
+// line and wires library pieces; nothing else.
+#include <iostream>
+
+#include "common/cli.hpp"
+#include "common/nn/mlp.hpp"
+#include "common/signals.hpp"
+#include "learner/bench.hpp"
+#include "learner/learner_node.hpp"
+
+namespace {
+
+using namespace auvrl;
+
+int run_bench(const std::string& algo, const std::string& hidden, int batch, int threads,
+              bool one_case, double seconds) {
+  std::vector<learner::BenchCase> cases;
+  if (one_case) {
+    learner::BenchCase c;
+    c.algo = learner::parse_algo(algo);
+    if (!hidden.empty()) c.hidden = learner::parse_hidden(hidden);
+    if (batch > 0) c.batch = batch;
+    c.threads = threads;
+    cases.push_back(c);
+  } else {
+    cases = learner::standard_bench_cases(learner::parse_algo(algo));
+    for (auto& c : cases) c.threads = threads;
+  }
+  for (auto& c : cases) {
+    c.seconds = seconds;
+    learner::print_bench_line(std::cout, learner::run_update_benchmark(c));
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  learner::LearnerNodeConfig config;
+  config.ddpg.state_dim = 23;
+  config.ddpg.action_dim = 6;
+  transport::TransportConfig transport_config;
+  std::string algo = "ddpg", hidden, actor_hidden, critic_hidden;
+  std::int64_t seed = 1, replay = static_cast<std::int64_t>(config.ddpg.replay_capacity);
+  int threads = 1;
+  bool bench = false, resume = false, keep_running = false;
+  double bench_seconds = 2.0;
+  int bench_batch = 0;
+
+  cli::CommandLine cmd("auv_learner",
+                       "Central learner: replay buffer and networks, DDPG/TD3 updates from the "
+                       "actors' experience, weights broadcast, schedule, checkpoints.");
+  cmd.option("algo", &algo, "ddpg or td3");
+  cmd.option("state-dim", &config.ddpg.state_dim, "observation size (the task's layout)");
+  cmd.option("action-dim", &config.ddpg.action_dim, "action size (thrusters)");
+  cmd.option("hidden", &hidden, "hidden sizes of both networks, e.g. 400-300");
+  cmd.option("actor-hidden", &actor_hidden, "hidden sizes of the actor (default 400-300)");
+  cmd.option("critic-hidden", &critic_hidden, "hidden sizes of the critic (default 400-300)");
+  cmd.option("critic-action-layer", &config.ddpg.critic_action_layer,
+             "critic layer receiving the action (0 input, 1 after the first hidden)");
+  cmd.option("batch", &config.ddpg.batch_size, "minibatch size m");
+  double actor_lr = config.ddpg.actor_lr, critic_lr = config.ddpg.critic_lr,
+         critic_l2 = config.ddpg.critic_weight_decay, gamma = config.ddpg.gamma,
+         tau = config.ddpg.tau;
+  cmd.option("actor-lr", &actor_lr, "Adam learning rate of the actor");
+  cmd.option("critic-lr", &critic_lr, "Adam learning rate of the critic");
+  cmd.option("critic-l2", &critic_l2, "L2 weight decay of the critic");
+  cmd.option("gamma", &gamma, "discount");
+  cmd.option("tau", &tau, "soft target update rate");
+  cmd.option("replay", &replay, "replay buffer capacity (transitions)");
+  cmd.option("seed", &seed, "seed of the networks, sampling and TD3 noise");
+  cmd.option("updates-per-transition", &config.updates_per_transition,
+             "gradient updates per transition received (paper: 1)");
+  cmd.option("warmup", &config.warmup_transitions, "transitions before the first update");
+  cmd.option("broadcast-every", &config.broadcast_every_updates, "weights after every N updates");
+  cmd.option("broadcast-interval", &config.broadcast_min_interval_s,
+             "at most one weights broadcast per this many seconds");
+  cmd.option("max-actors", &config.max_actors, "actor ids accepted: 0..N-1");
+  cmd.option("max-episodes", &config.max_episodes, "end of training in episodes (0: never)");
+  cmd.option("max-updates", &config.max_updates, "end of training in updates (0: never)");
+  cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
+  cmd.option("checkpoint-period", &config.checkpoint_period_s, "seconds between checkpoints");
+  cmd.option("keep-checkpoints", &config.keep_checkpoints, "checkpoints kept");
+  cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
+  cmd.flag("resume", &resume, "continue from the newest usable checkpoint in --checkpoint-dir");
+  cmd.flag("keep-running", &keep_running, "keep serving after training is done");
+  cmd.option("threads", &threads, "threads for the matrix products");
+  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.flag("allow-off-host", &transport_config.allow_off_host,
+           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  cmd.flag("bench", &bench,
+           "print updates/s for 64-64 batch 100, 256-256 batch 256, 400-300 batch 64 (or the one "
+           "case --hidden/--batch give) and exit");
+  cmd.option("bench-seconds", &bench_seconds, "measuring time per benchmark case");
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+    config.ddpg.algo = learner::parse_algo(algo);
+    if (!hidden.empty()) {
+      config.ddpg.actor_hidden = config.ddpg.critic_hidden = learner::parse_hidden(hidden);
+    }
+    if (!actor_hidden.empty()) config.ddpg.actor_hidden = learner::parse_hidden(actor_hidden);
+    if (!critic_hidden.empty()) config.ddpg.critic_hidden = learner::parse_hidden(critic_hidden);
+    config.ddpg.actor_lr = static_cast<float>(actor_lr);
+    config.ddpg.critic_lr = static_cast<float>(critic_lr);
+    config.ddpg.critic_weight_decay = static_cast<float>(critic_l2);
+    config.ddpg.gamma = static_cast<float>(gamma);
+    config.ddpg.tau = static_cast<float>(tau);
+    config.ddpg.seed = static_cast<std::uint64_t>(seed);
+    if (replay < 1) throw cli::UsageError("option --replay: must be >= 1");
+    config.ddpg.replay_capacity = static_cast<std::size_t>(replay);
+    bench_batch = config.ddpg.batch_size;
+    if (resume && config.checkpoint_dir.empty()) {
+      throw cli::UsageError("option --resume needs --checkpoint-dir");
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "auv_learner: " << e.what() << "\n";
+    return 2;
+  }
+
+  try {
+    nn::set_num_threads(threads);
+    if (bench) {
+      bool one_case = false;
+      for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        one_case |= a.rfind("--hidden", 0) == 0 || a.rfind("--batch", 0) == 0;
+      }
+      return run_bench(algo, hidden, bench_batch, threads, one_case, bench_seconds);
+    }
+    auto transport = transport::make_transport(transport_config);
+    signals::install_stop_handlers();
+    learner::LearnerNode node(config, *transport, std::cerr);
+    if (resume) node.resume();
+    std::cerr << "auv_learner: " << algo << ", actor " << node.algorithm().actor().spec().describe()
+              << ", buffer " << config.ddpg.replay_capacity << ", " << transport_config.lcm_url
+              << "\n";
+    bool announced_done = false;
+    while (!signals::stop_requested()) {
+      node.poll(50);
+      if (node.training_done() && !announced_done) {
+        announced_done = true;
+        std::cerr << "auv_learner: training done after " << node.episodes() << " episodes, "
+                  << node.updates() << " updates\n";
+        if (!keep_running) break;
+      }
+    }
+    node.finish();
+  } catch (const std::exception& e) {
+    std::cerr << "auv_learner: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

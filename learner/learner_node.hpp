@@ -1,0 +1,145 @@
+// auv_learner's logic: owns the replay buffer and the networks, turns actors' experience into
+// DDPG/TD3 updates at a set ratio, broadcasts the actor's weights, owns the training schedule
+// (episodes, beta), publishes its figures and checkpoints everything.
+#pragma once
+
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/experience_batch_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/policy_weights_t.hpp>
+#include <auvrl_lcm/weights_request_t.hpp>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "common/task/goal_schedule.hpp"
+#include "common/transport.hpp"
+#include "learner/ddpg.hpp"
+#include "learner/replay_buffer.hpp"
+
+namespace auvrl::learner {
+
+/// Everything auv_learner is configured with besides the transport.
+struct LearnerNodeConfig {
+  DdpgConfig ddpg;  ///< algorithm, dims, networks, rates (replay_capacity sizes the buffer)
+
+  /// Gradient updates per transition received (the paper: one per environment step).
+  double updates_per_transition = 1.0;
+  /// Updates start once the buffer holds more than max(batch_size, this) transitions
+  /// (Algorithm 1, line 11: |R| > m).
+  std::int64_t warmup_transitions = 0;
+  /// Most updates owed at once: when actors produce faster than the learner updates, the
+  /// surplus is forgotten rather than owed forever (counted in updates_skipped()).
+  double max_update_backlog = 1000.0;
+  /// Most updates between two looks at the network, so requests are answered promptly.
+  int max_updates_per_poll = 16;
+
+  /// Weights go out after every this many updates...
+  int broadcast_every_updates = 1;
+  /// ...but at most once per this interval (0: no limit), s.
+  double broadcast_min_interval_s = 0.05;
+
+  int max_actors = 64;                 ///< accepted actor ids: 0 .. max_actors - 1
+  int max_transitions_per_batch = 10000;
+  double stats_period_s = 1.0;
+
+  task::GoalSchedule schedule;         ///< beta from the episode count
+  std::int64_t max_episodes = 0;       ///< training ends after this many episodes (0: never)
+  std::int64_t max_updates = 0;        ///< or after this many updates (0: never)
+
+  std::string checkpoint_dir;          ///< empty: no checkpoints
+  double checkpoint_period_s = 300.0;
+  int keep_checkpoints = 2;
+  std::string policy_path;             ///< where finish() writes the actor network (optional)
+};
+
+/// Counters of what arrived and what was done with it.
+struct LearnerCounters {
+  std::int64_t transitions_received = 0;
+  std::int64_t batches_received = 0;
+  std::int64_t dropped_dims = 0;
+  std::int64_t dropped_non_finite = 0;
+  std::int64_t dropped_unknown_actor = 0;
+  std::int64_t batches_lost = 0;
+  std::int64_t weights_published = 0;
+  std::int64_t weights_requests = 0;
+  std::int64_t episodes = 0;
+  std::int64_t checkpoints_written = 0;
+  std::int64_t updates_skipped = 0;
+  std::int64_t dropped_decode = 0;
+};
+
+/// The learner as a transport participant. Single-threaded: call poll() in a loop.
+class LearnerNode {
+ public:
+  LearnerNode(LearnerNodeConfig config, transport::Transport& transport, std::ostream& log);
+  ~LearnerNode();
+  LearnerNode(const LearnerNode&) = delete;
+  LearnerNode& operator=(const LearnerNode&) = delete;
+
+  /// Handles what has arrived (waiting up to timeout_ms when there is nothing to update),
+  /// runs the updates owed, and publishes weights, statistics and checkpoints when due.
+  void poll(int timeout_ms);
+
+  /// True once the schedule's end (max_episodes or max_updates) is reached.
+  bool training_done() const;
+
+  /// Writes a checkpoint now (if a directory is configured); returns its path or "".
+  std::string checkpoint();
+  /// Restores the newest usable checkpoint of the configured directory. Throws
+  /// std::runtime_error (naming the file and what is wrong) if there is none.
+  void resume();
+  /// Final checkpoint, policy file and a last broadcast of the weights.
+  void finish();
+
+  std::int64_t updates() const { return ddpg_->updates(); }
+  std::int64_t episodes() const { return counters_.episodes; }
+  double beta_m() const { return config_.schedule.beta_m(counters_.episodes); }
+  const ReplayBuffer& replay() const { return *replay_; }
+  const Ddpg& algorithm() const { return *ddpg_; }
+  LearnerCounters counters() const;
+
+  /// The policy_weights_t for the current actor network.
+  auvrl_lcm::policy_weights_t weights_message() const;
+
+ private:
+  void on_experience(const auvrl_lcm::experience_batch_t& msg);
+  void on_weights_request(const auvrl_lcm::weights_request_t& msg);
+  void on_episode(const auvrl_lcm::episode_report_t& msg);
+  void run_updates();
+  /// Publishes the weights if requested, or if due by update count and allowed by the rate.
+  void maybe_publish_weights();
+  void publish_weights();
+  void publish_stats();
+  void save(nn::Writer& w) const;
+
+  LearnerNodeConfig config_;
+  transport::Transport& transport_;
+  std::ostream& log_;
+  std::unique_ptr<Ddpg> ddpg_;
+  std::unique_ptr<ReplayBuffer> replay_;
+  LearnerCounters counters_;
+  transport::DecodeStats decode_stats_;
+  std::vector<transport::SubscriptionId> subscriptions_;
+  std::vector<std::int64_t> last_batch_seq_;  ///< per actor, -1: none yet
+
+  double update_credit_ = 0.0;
+  std::int64_t last_broadcast_updates_ = -1;
+  bool broadcast_requested_ = true;  ///< answer a request (or announce a start) at once
+  std::chrono::steady_clock::time_point last_broadcast_;
+  std::chrono::steady_clock::time_point next_stats_;
+  std::chrono::steady_clock::time_point next_checkpoint_;
+
+  // Statistics over the current stats interval.
+  std::int64_t interval_updates_ = 0;
+  std::int64_t interval_transitions_ = 0;
+  double interval_critic_loss_ = 0.0;
+  double interval_actor_loss_ = 0.0;
+  double interval_mean_q_ = 0.0;
+  std::chrono::steady_clock::time_point interval_start_;
+};
+
+}  // namespace auvrl::learner

@@ -1,0 +1,278 @@
+// auv_learner as a real process in a private network namespace, fed by two fake actors: the
+// actors get weights on request, see the version rise after each update, bad batches are
+// dropped and counted; a checkpoint, kill -9 and --resume continue from the same update count
+// with the same buffer content.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <auvrl_lcm/experience_batch_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/policy_weights_t.hpp>
+#include <auvrl_lcm/weights_request_t.hpp>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "child_process.hpp"
+#include "common/channels.hpp"
+#include "common/nn/serialize.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/learner_node.hpp"
+
+namespace {
+
+using namespace auvrl;
+using test_support::ChildProcess;
+
+constexpr int kStateDim = 8;
+constexpr int kActionDim = 2;
+constexpr int kBatch = 32;
+
+/// A fake actor: its own LCM instance, sends experience and requests, watches the weights.
+struct FakeActor {
+  explicit FakeActor(int id) : actor_id(id), transport(transport::make_transport({})) {
+    // Every message, not just the newest: the test checks that each version was broadcast.
+    transport::subscribe<auvrl_lcm::policy_weights_t>(
+        *transport, channels::kPolicyWeights,
+        [this](const std::string&, const auvrl_lcm::policy_weights_t& w) {
+          versions.push_back(w.version);
+          last = w;
+        });
+  }
+
+  void request_weights() {
+    auvrl_lcm::weights_request_t req{};
+    req.utime = transport::now_utime();
+    req.actor_id = actor_id;
+    req.have_version = -1;
+    transport::publish(*transport, channels::kWeightsRequest, req);
+  }
+
+  /// A batch of n transitions whose values follow from (actor, seq): reproducible.
+  auvrl_lcm::experience_batch_t make_batch(int n) {
+    auvrl_lcm::experience_batch_t b{};
+    b.actor_id = actor_id;
+    b.batch_seq = ++seq;
+    b.state_dim = kStateDim;
+    b.action_dim = kActionDim;
+    b.num_transitions = n;
+    std::mt19937 rng(static_cast<unsigned>(actor_id * 100000 + seq));
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int i = 0; i < n; ++i) {
+      std::vector<float> s(kStateDim), s2(kStateDim), a(kActionDim);
+      for (auto& v : s) v = u(rng);
+      for (auto& v : s2) v = u(rng);
+      for (auto& v : a) v = u(rng);
+      b.states.push_back(s);
+      b.next_states.push_back(s2);
+      b.actions.push_back(a);
+      b.rewards.push_back(u(rng));
+      b.terminal.push_back(i % 17 == 0);
+      b.achieved_position_ned_m.push_back({u(rng), u(rng), u(rng)});
+      b.goal_ned_m.push_back({1.0f, 2.0f, 3.0f});
+      b.episode_id.push_back(seq);
+      b.step_index.push_back(i);
+    }
+    return b;
+  }
+
+  void send(const auvrl_lcm::experience_batch_t& b) {
+    transport::publish(*transport, channels::kExperience, b);
+  }
+
+  /// Handles traffic for up to ms; records every weights version seen.
+  void pump(int ms) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+    while (std::chrono::steady_clock::now() < end) transport->handle(10);
+  }
+
+  int actor_id;
+  std::int64_t seq = 0;
+  std::unique_ptr<transport::Transport> transport;
+  std::vector<std::int64_t> versions;
+  auvrl_lcm::policy_weights_t last{};
+};
+
+std::vector<std::string> learner_args(const std::string& dir, bool resume) {
+  std::vector<std::string> args = {test_support::bin_path("auv_learner"),
+                                   "--algo", "td3",
+                                   "--state-dim", std::to_string(kStateDim),
+                                   "--action-dim", std::to_string(kActionDim),
+                                   "--hidden", "32-32",
+                                   "--batch", std::to_string(kBatch),
+                                   "--replay", "5000",
+                                   "--broadcast-every", "1",
+                                   "--broadcast-interval", "0",
+                                   "--max-actors", "4",
+                                   "--checkpoint-dir", dir + "/checkpoints",
+                                   "--checkpoint-period", "0.3",
+                                   "--seed", "5"};
+  if (resume) args.push_back("--resume");
+  return args;
+}
+
+learner::LearnerNodeConfig in_process_config(const std::string& dir) {
+  learner::LearnerNodeConfig c;
+  c.ddpg.algo = learner::Algo::kTd3;
+  c.ddpg.state_dim = kStateDim;
+  c.ddpg.action_dim = kActionDim;
+  c.ddpg.actor_hidden = c.ddpg.critic_hidden = {32, 32};
+  c.ddpg.batch_size = kBatch;
+  c.ddpg.replay_capacity = 5000;
+  c.ddpg.seed = 5;
+  c.checkpoint_dir = dir + "/checkpoints";
+  c.max_actors = 4;
+  return c;
+}
+
+TEST(LearnerProcess, WeightsRiseCheckpointKillResume) {
+  const std::string dir = test_support::make_temp_dir("auvrl_learner_process_");
+  auto learner = std::make_unique<ChildProcess>(learner_args(dir, false), dir + "/learner1.log");
+  FakeActor a(0), b(1);
+  transport::Latest<auvrl_lcm::learner_stats_t> stats(*a.transport, channels::kLearnerStats);
+
+  // A starting actor asks and gets the current policy (version 0) at once.
+  for (int i = 0; i < 50 && a.versions.empty(); ++i) {
+    a.request_weights();
+    a.pump(100);
+  }
+  ASSERT_FALSE(a.versions.empty()) << learner->log();
+  EXPECT_EQ(a.versions.front(), 0);
+  nn::Mlp policy = nn::network_from_bytes(
+      reinterpret_cast<const std::uint8_t*>(a.last.network.data()), a.last.network.size(), 1);
+  EXPECT_EQ(policy.spec().input_dim, kStateDim);
+  EXPECT_EQ(policy.spec().output_dim, kActionDim);
+
+  // Experience from both actors; both see the version rise, one by one update.
+  std::vector<auvrl_lcm::experience_batch_t> sent;
+  for (int round = 0; round < 6; ++round) {
+    sent.push_back(a.make_batch(20));
+    a.send(sent.back());
+    sent.push_back(b.make_batch(20));
+    b.send(sent.back());
+    a.pump(100);
+    b.pump(100);
+  }
+  a.pump(500);
+  b.pump(500);
+  for (FakeActor* actor : {&a, &b}) {
+    ASSERT_GE(actor->versions.size(), 10u) << learner->log();
+    EXPECT_TRUE(std::is_sorted(actor->versions.begin(), actor->versions.end()));
+    EXPECT_GT(actor->versions.back(), 0);
+  }
+  // One update per transition from the moment the buffer holds more than a batch (|R| > m).
+  EXPECT_EQ(a.versions.back(), 240 - kBatch);
+  // Every version from the first update to the last was broadcast (after each update).
+  std::vector<std::int64_t> seen = a.versions;
+  seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+  EXPECT_EQ(seen.size(), static_cast<std::size_t>(240 - kBatch + 1)) << "weights were not broadcast after each update";
+
+  // Hostile batches: dropped and counted, never applied.
+  auto bad = a.make_batch(5);
+  bad.state_dim = kStateDim + 1;  // claims another dimension
+  for (auto& row : bad.states) row.push_back(0.0f);
+  for (auto& row : bad.next_states) row.push_back(0.0f);
+  a.send(bad);
+  auto nan = a.make_batch(5);
+  nan.rewards[2] = std::nanf("");
+  a.send(nan);
+  auto wild = a.make_batch(5);
+  wild.actions[0][0] = 7.0f;  // not a tanh output
+  a.send(wild);
+  auto stranger = a.make_batch(5);
+  stranger.actor_id = 99;
+  a.send(stranger);
+  std::optional<auvrl_lcm::learner_stats_t> s;
+  for (int i = 0; i < 60; ++i) {
+    a.pump(50);
+    if (auto got = stats.take(); got && got->dropped_dims >= 1 && got->dropped_non_finite >= 2 &&
+                                 got->dropped_unknown_actor >= 1 && got->checkpoints_written >= 2) {
+      s = got;
+      break;
+    }
+  }
+  ASSERT_TRUE(s.has_value()) << learner->log();
+  EXPECT_EQ(s->updates, 240 - kBatch);
+  EXPECT_EQ(s->transitions_received, 240);
+  EXPECT_EQ(s->buffer_size, 240);
+
+  // Let a checkpoint with the final state land, then kill -9.
+  a.pump(800);
+  learner->signal(SIGKILL);
+  learner->wait_for_exit(std::chrono::seconds(5));
+  const auto files = learner::list_checkpoints(dir + "/checkpoints");
+  ASSERT_FALSE(files.empty());
+  EXPECT_EQ(files.front().updates, 240 - kBatch);
+
+  // The checkpoint holds exactly what was sent, in order.
+  {
+    std::ostringstream log;
+    auto t = transport::make_in_process_transport();
+    learner::LearnerNode restored(in_process_config(dir), *t, log);
+    restored.resume();
+    ASSERT_EQ(restored.updates(), 240 - kBatch);
+    const auto& replay = restored.replay();
+    ASSERT_EQ(replay.size(), 240u);
+    std::size_t slot = 0;
+    for (const auto& batch : sent) {
+      for (int i = 0; i < batch.num_transitions; ++i, ++slot) {
+        for (int k = 0; k < kStateDim; ++k) {
+          ASSERT_EQ(replay.state(slot)[k], batch.states[i][k]) << "slot " << slot;
+          ASSERT_EQ(replay.next_state(slot)[k], batch.next_states[i][k]);
+        }
+        ASSERT_EQ(replay.reward(slot), batch.rewards[i]);
+        ASSERT_EQ(replay.terminal(slot), batch.terminal[i] != 0);
+      }
+    }
+  }
+
+  // --resume: the same update count, the same buffer, and the weights of that checkpoint.
+  learner = std::make_unique<ChildProcess>(learner_args(dir, true), dir + "/learner2.log");
+  FakeActor c(2);
+  for (int i = 0; i < 50 && c.versions.empty(); ++i) {
+    c.request_weights();
+    c.pump(100);
+  }
+  ASSERT_FALSE(c.versions.empty()) << learner->log();
+  EXPECT_EQ(c.versions.front(), 240 - kBatch);
+  EXPECT_EQ(c.last.network, a.last.network) << "resumed weights differ from the last broadcast";
+  c.send(c.make_batch(10));
+  for (int i = 0; i < 40 && c.versions.back() < 250 - kBatch; ++i) c.pump(50);
+  EXPECT_EQ(c.versions.back(), 250 - kBatch) << learner->log();
+  const int status = learner->terminate();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << learner->log();
+  EXPECT_NE(learner->log().find("resumed from"), std::string::npos);
+}
+
+TEST(LearnerProcess, DamagedNewestCheckpointFallsBackToThePreviousOne) {
+  const std::string dir = test_support::make_temp_dir("auvrl_learner_ckpt_");
+  std::ostringstream log;
+  auto t = transport::make_in_process_transport();
+  auto config = in_process_config(dir);
+  config.keep_checkpoints = 3;
+  {
+    learner::LearnerNode node(config, *t, log);
+    ASSERT_NE(node.checkpoint(), "");
+    auvrl_lcm::experience_batch_t batch = FakeActor(0).make_batch(50);
+    transport::publish(*t, channels::kExperience, batch);
+    for (int i = 0; i < 10; ++i) node.poll(10);
+    ASSERT_EQ(node.updates(), 50 - kBatch);
+    ASSERT_NE(node.checkpoint(), "");
+  }
+  auto files = learner::list_checkpoints(dir + "/checkpoints");
+  ASSERT_EQ(files.size(), 2u);
+  // Truncate the newest.
+  std::filesystem::resize_file(files.front().path, 1000);
+  learner::LearnerNode node(config, *t, log);
+  node.resume();
+  EXPECT_EQ(node.updates(), 0);
+  EXPECT_NE(log.str().find("is unusable"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find(files.front().path), std::string::npos);
+  // Both damaged: a clear error.
+  std::filesystem::resize_file(files.back().path, 10);
+  learner::LearnerNode node2(config, *t, log);
+  EXPECT_THROW(node2.resume(), std::runtime_error);
+}
+
+}  // namespace
