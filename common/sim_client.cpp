@@ -19,6 +19,7 @@ SimClient::SimClient(transport::Transport& transport, int vehicle_id, LockstepTi
         if (state.seq == awaited_seq_ && state.vehicle_id == vehicle_id_) answer_ = state;
       });
   command_.vehicle_id = vehicle_id;
+  command_channel_ = channels::sim_command(vehicle_id);
 }
 
 SimClient::~SimClient() { transport_.unsubscribe(subscription_); }
@@ -57,7 +58,7 @@ std::optional<auvrl_lcm::vehicle_state_t> SimClient::step(const std::vector<doub
   command_.utime = transport::now_utime();
   command_.num_thrusters = static_cast<std::int8_t>(thrust_n.size());
   command_.thrust_n = thrust_n;
-  return request(channels::sim_command(vehicle_id_), command_);
+  return request(command_channel_, command_);
 }
 
 }  // namespace auvrl

@@ -52,6 +52,7 @@ class SimClient {
   std::int64_t awaited_seq_ = -1;
   std::optional<auvrl_lcm::vehicle_state_t> answer_;
   auvrl_lcm::thruster_cmd_t command_;
+  std::string command_channel_;
   std::int64_t retries_ = 0;
   std::int64_t timeouts_ = 0;
 };

@@ -109,7 +109,9 @@ template <class Msg>
 void publish(Transport& transport, const std::string& channel, const Msg& msg) {
   const int size = msg.getEncodedSize();
   if (size < 0) throw TransportError("cannot encode a message for channel " + channel);
-  std::vector<std::uint8_t> buffer(static_cast<std::size_t>(size));
+  // Reused per thread: publishing in a control loop should not allocate every message.
+  thread_local std::vector<std::uint8_t> buffer;
+  buffer.resize(static_cast<std::size_t>(size));
   if (msg.encode(buffer.data(), 0, size) != size) {
     throw TransportError("cannot encode a message for channel " + channel);
   }
