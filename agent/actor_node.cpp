@@ -1,0 +1,177 @@
+#include "agent/actor_node.hpp"
+
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/experience_batch_t.hpp>
+#include <auvrl_lcm/weights_request_t.hpp>
+
+#include "common/channels.hpp"
+#include "common/nn/serialize.hpp"
+
+namespace auvrl::agent {
+
+using Clock = std::chrono::steady_clock;
+
+/// Acts with the newest policy the actor holds, checking for new weights every step so the
+/// actor never acts on a stale version longer than one control step; zeros (noise alone)
+/// until the first weights arrive.
+class ActorNode::ExploringController final : public Controller {
+ public:
+  explicit ExploringController(ActorNode& node) : node_(node) {}
+  void act(const task::Observation& obs, const Eigen::Vector3d& goal,
+           const task::StateVector& state, task::ActionVector& action) override {
+    node_.refresh_policy();
+    if (policy_) {
+      policy_->act(obs, goal, state, action);
+    } else {
+      action.setZero(node_.config_.task.num_thrusters);
+    }
+  }
+  std::string name() const override { return "actor"; }
+  std::unique_ptr<PolicyController> policy_;
+
+ private:
+  ActorNode& node_;
+};
+
+ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log)
+    : config_(std::move(config)),
+      transport_(transport),
+      log_(log),
+      link_(make_lockstep_link(transport, config_.vehicle_id, config_.task.num_thrusters)),
+      weights_(transport, channels::kPolicyWeights, 8),
+      controller_(std::make_unique<ExploringController>(*this)),
+      noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
+             config_.seed * 0x9E3779B97F4A7C15ull + 1),
+      goal_rng_(config_.seed),
+      beta_m_(config_.initial_beta_m) {
+  config_.task.validate();
+  last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
+}
+
+ActorNode::~ActorNode() = default;
+
+void ActorNode::refresh_policy() {
+  // Weights supersede each other: drain what is pending, keep only the newest.
+  transport_.drain();
+  if (auto msg = weights_.take()) {
+    last_weights_ = Clock::now();
+    training_done_ = msg->training_done;
+    if (msg->version != policy_version_ || !controller_->policy_) {
+      try {
+        nn::Mlp network = nn::network_from_bytes(
+            reinterpret_cast<const std::uint8_t*>(msg->network.data()), msg->network.size(), 1);
+        auto policy = std::make_unique<PolicyController>(
+            std::move(network), config_.task.state_dim(), config_.task.num_thrusters);
+        controller_->policy_ = std::move(policy);
+        policy_version_ = msg->version;
+        beta_m_ = msg->beta_m;
+        ++counters_.weights_applied;
+      } catch (const std::exception& e) {
+        ++counters_.weights_rejected;
+        log_ << "auv_actor " << config_.actor_id << ": weights version " << msg->version
+             << " rejected: " << e.what() << "\n";
+      }
+    } else {
+      beta_m_ = msg->beta_m;
+    }
+  }
+  const auto now = Clock::now();
+  const double silence = std::chrono::duration<double>(now - last_weights_).count();
+  const double since_request = std::chrono::duration<double>(now - last_request_).count();
+  const bool want = !controller_->policy_ || silence > config_.weights_silence_s;
+  if (want && since_request >= config_.weights_request_period_s) {
+    auvrl_lcm::weights_request_t req{};
+    req.utime = transport::now_utime();
+    req.actor_id = config_.actor_id;
+    req.have_version = policy_version_;
+    transport::publish(transport_, channels::kWeightsRequest, req);
+    last_request_ = now;
+    ++counters_.weights_requests;
+  }
+}
+
+EpisodeSummary ActorNode::run_one_episode() {
+  refresh_policy();
+  ++episode_id_;
+  EpisodeOptions options;
+  options.goal_ned_m = task::sample_goal(config_.task, goal_rng_);
+  options.beta_m = beta_m_;
+  options.start.position_ned_m = config_.task.start_position_ned_m;
+  options.start.euler_rpy_rad = {0.0, 0.0, config_.task.start_yaw_rad};
+  options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
+  options.noise = &noise_;
+  std::vector<Transition> transitions;
+  transitions.reserve(static_cast<std::size_t>(config_.task.max_steps));
+  options.on_transition = [&transitions](const Transition& t) { transitions.push_back(t); };
+
+  const EpisodeSummary summary = run_episode(config_.task, *link_, *controller_, options);
+  ++counters_.episodes;
+  counters_.steps += summary.length_steps;
+  if (summary.end_reason == task::EndReason::kBlowUp ||
+      summary.end_reason == task::EndReason::kSimTimeout) {
+    // A numerical blow-up or a lost simulator: none of this episode is trusted.
+    ++counters_.episodes_discarded;
+  } else {
+    send_experience(transitions, options.goal_ned_m);
+  }
+  send_report(summary, options.goal_ned_m);
+  return summary;
+}
+
+void ActorNode::send_experience(const std::vector<Transition>& transitions,
+                                const Eigen::Vector3d& goal) {
+  const int state_dim = config_.task.state_dim();
+  const int action_dim = config_.task.num_thrusters;
+  const std::vector<float> goal_row = {static_cast<float>(goal[0]), static_cast<float>(goal[1]),
+                                       static_cast<float>(goal[2])};
+  for (std::size_t begin = 0; begin < transitions.size();
+       begin += static_cast<std::size_t>(config_.max_transitions_per_message)) {
+    const std::size_t end = std::min(
+        transitions.size(), begin + static_cast<std::size_t>(config_.max_transitions_per_message));
+    auvrl_lcm::experience_batch_t msg;
+    msg.utime = transport::now_utime();
+    msg.actor_id = config_.actor_id;
+    msg.batch_seq = ++batch_seq_;
+    msg.policy_version = std::max<std::int64_t>(policy_version_, 0);
+    msg.state_dim = state_dim;
+    msg.action_dim = action_dim;
+    msg.num_transitions = static_cast<std::int32_t>(end - begin);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Transition& t = transitions[i];
+      msg.states.emplace_back(t.state.data(), t.state.data() + state_dim);
+      msg.actions.emplace_back(t.action.data(), t.action.data() + action_dim);
+      msg.rewards.push_back(static_cast<float>(t.reward));
+      msg.next_states.emplace_back(t.next_state.data(), t.next_state.data() + state_dim);
+      msg.terminal.push_back(t.terminal ? 1 : 0);
+      msg.achieved_position_ned_m.push_back({static_cast<float>(t.achieved_position_ned_m[0]),
+                                             static_cast<float>(t.achieved_position_ned_m[1]),
+                                             static_cast<float>(t.achieved_position_ned_m[2])});
+      msg.goal_ned_m.push_back(goal_row);
+      msg.episode_id.push_back(episode_id_);
+      msg.step_index.push_back(t.step_index);
+    }
+    transport::publish(transport_, channels::kExperience, msg);
+    counters_.transitions_sent += msg.num_transitions;
+    ++counters_.batches_sent;
+  }
+}
+
+void ActorNode::send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal) {
+  auvrl_lcm::episode_report_t report{};
+  report.utime = transport::now_utime();
+  report.actor_id = config_.actor_id;
+  report.episode_id = episode_id_;
+  report.policy_version = std::max<std::int64_t>(policy_version_, 0);
+  report.episode_return = summary.episode_return;
+  report.length_steps = summary.length_steps;
+  report.success = summary.success;
+  report.final_distance_m = summary.final_distance_m;
+  report.min_distance_m = summary.min_distance_m;
+  report.beta_m = beta_m_;
+  for (int i = 0; i < 3; ++i) report.goal_ned_m[i] = goal[i];
+  report.thrust_energy = summary.thrust_energy;
+  report.end_reason = static_cast<std::int8_t>(summary.end_reason);
+  transport::publish(transport_, channels::kEpisode, report);
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,93 @@
+// auv_actor's logic: runs episodes of the goal-driven task against its own vehicle of auv_sim
+// in lockstep, acting with its newest copy of the policy plus exploration noise, and sends the
+// transitions to the learner and a report of every episode.
+#pragma once
+
+#include <auvrl_lcm/policy_weights_t.hpp>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <ostream>
+#include <random>
+
+#include "agent/controller.hpp"
+#include "agent/episode.hpp"
+#include "agent/vehicle_link.hpp"
+#include "common/sim_client.hpp"
+#include "common/task/task.hpp"
+#include "common/transport.hpp"
+
+namespace auvrl::agent {
+
+/// Everything auv_actor is configured with besides the transport.
+struct ActorNodeConfig {
+  int actor_id = 0;
+  int vehicle_id = 0;  ///< its vehicle in auv_sim
+  task::TaskConfig task;
+  ExplorationNoise::Kind noise = ExplorationNoise::Kind::kOrnsteinUhlenbeck;
+  double noise_sigma = 0.2;   ///< OU or Gaussian standard deviation (actions in [-1, 1])
+  double noise_theta = 0.15;  ///< OU mean reversion per step
+  std::uint64_t seed = 1;     ///< way-points and noise; each actor needs its own
+  double initial_beta_m = 1.5;  ///< goal radius until the learner's first weights say otherwise
+  int max_transitions_per_message = 256;  ///< keeps an experience message near one datagram
+  double weights_request_period_s = 0.5;  ///< while it has no policy, ask this often
+  double weights_silence_s = 10.0;        ///< with a policy: ask again after this long unheard
+  std::int64_t max_episodes = 0;          ///< stop after this many (0: until told to stop)
+};
+
+/// Counters for logs and tests.
+struct ActorCounters {
+  std::int64_t episodes = 0;
+  std::int64_t steps = 0;
+  std::int64_t transitions_sent = 0;
+  std::int64_t batches_sent = 0;
+  std::int64_t episodes_discarded = 0;  ///< blow-up or simulator timeout: nothing sent
+  std::int64_t weights_applied = 0;
+  std::int64_t weights_rejected = 0;    ///< checksum, format or size mismatch
+  std::int64_t weights_requests = 0;
+};
+
+/// The actor as a transport participant. Single-threaded.
+class ActorNode {
+ public:
+  ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log);
+  ~ActorNode();
+  ActorNode(const ActorNode&) = delete;
+  ActorNode& operator=(const ActorNode&) = delete;
+
+  /// Runs one episode and reports it; returns its summary.
+  EpisodeSummary run_one_episode();
+
+  /// The learner said training is over.
+  bool training_done() const { return training_done_; }
+  std::int64_t policy_version() const { return policy_version_; }
+  double beta_m() const { return beta_m_; }
+  const ActorCounters& counters() const { return counters_; }
+
+ private:
+  class ExploringController;
+
+  /// Applies the newest weights that have arrived (drained, newest kept); asks when due.
+  void refresh_policy();
+  void send_experience(const std::vector<Transition>& transitions, const Eigen::Vector3d& goal);
+  void send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal);
+
+  ActorNodeConfig config_;
+  transport::Transport& transport_;
+  std::ostream& log_;
+  std::unique_ptr<VehicleLink> link_;
+  transport::Latest<auvrl_lcm::policy_weights_t> weights_;
+  std::unique_ptr<ExploringController> controller_;
+  ExplorationNoise noise_;
+  std::mt19937_64 goal_rng_;
+  ActorCounters counters_;
+  std::int64_t policy_version_ = -1;  ///< -1: no policy yet (noise alone)
+  double beta_m_;
+  bool training_done_ = false;
+  std::int64_t batch_seq_ = 0;
+  std::int64_t episode_id_ = 0;
+  std::chrono::steady_clock::time_point last_weights_;
+  std::chrono::steady_clock::time_point last_request_;
+};
+
+}  // namespace auvrl::agent

@@ -1,0 +1,100 @@
+// auv_actor: an exploration actor (episodes against its own vehicle of auv_sim, the newest
+// policy plus noise, experience to the learner). Parses the command line and wires library
+// pieces; nothing else.
+#include <sched.h>
+
+#include <iostream>
+
+#include "agent/actor_node.hpp"
+#include "common/cli.hpp"
+#include "common/signals.hpp"
+
+int main(int argc, char** argv) {
+  using namespace auvrl;
+  agent::ActorNodeConfig config;
+  transport::TransportConfig transport_config;
+  std::string layout = "extended", reward = "paper", noise = "ou";
+  int vehicle_id = -1, pin_cpu = -1, report_every = 50;
+  std::int64_t seed = 1;
+  double start_z = config.task.start_position_ned_m.z();
+
+  cli::CommandLine cmd("auv_actor",
+                       "Exploration actor: runs episodes of the goal-driven task on its vehicle "
+                       "of auv_sim with the newest policy plus noise; sends experience.");
+  cmd.option("actor-id", &config.actor_id, "this actor's id (0..)");
+  cmd.option("vehicle-id", &vehicle_id, "its vehicle in auv_sim (default: the actor id)");
+  cmd.option("layout", &layout, "state layout: paper or extended");
+  cmd.option("reward", &reward, "reward: paper (Eq. 14) or shaped");
+  cmd.option("failure-reward", &config.task.failure_reward,
+             "reward on leaving beta_max or flipping (paper -10; -1/(1-gamma) fixes it)");
+  cmd.option("thrust-weight", &config.task.thrust_weight, "weight of the thrust cost f(Tr)");
+  cmd.option("beta-max", &config.task.beta_max_m, "safety radius around the goal, m");
+  cmd.flag("hold", &config.task.hold_mode, "reaching does not end the episode (learn to hold)");
+  cmd.option("max-steps", &config.task.max_steps, "episode length limit (700 = 70 s)");
+  cmd.option("start-depth", &start_z, "start depth, m (start is [0, 0, depth])");
+  cmd.option("noise", &noise, "exploration noise: ou, gaussian or none");
+  cmd.option("noise-sigma", &config.noise_sigma, "noise standard deviation");
+  cmd.option("noise-theta", &config.noise_theta, "OU mean reversion per step");
+  cmd.option("initial-beta", &config.initial_beta_m, "goal radius until the learner's first");
+  cmd.option("seed", &seed, "seed of way-points and noise (give each actor its own)");
+  cmd.option("max-episodes", &config.max_episodes, "stop after this many (0: until stopped)");
+  cmd.option("pin-cpu", &pin_cpu, "pin this process to one CPU (-1: no)");
+  cmd.option("report-every", &report_every, "a log line every N episodes");
+  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.flag("allow-off-host", &transport_config.allow_off_host,
+           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+    config.task.layout = task::parse_layout(layout);
+    config.task.reward = task::parse_reward_kind(reward);
+    config.noise = agent::parse_noise_kind(noise);
+    config.task.start_position_ned_m.z() = start_z;
+    config.vehicle_id = vehicle_id >= 0 ? vehicle_id : config.actor_id;
+    config.seed = static_cast<std::uint64_t>(seed);
+    config.task.validate();
+  } catch (const std::exception& e) {
+    std::cerr << "auv_actor: " << e.what() << "\n";
+    return 2;
+  }
+  if (pin_cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(pin_cpu, &set);
+    if (sched_setaffinity(0, sizeof set, &set) != 0) {
+      std::cerr << "auv_actor: cannot pin to CPU " << pin_cpu << " (continuing unpinned)\n";
+    }
+  }
+
+  try {
+    auto transport = transport::make_transport(transport_config);
+    signals::install_stop_handlers();
+    agent::ActorNode node(config, *transport, std::cerr);
+    std::cerr << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
+              << layout << " state (" << config.task.state_dim() << "), " << reward
+              << " reward, " << noise << " noise, seed " << seed << "\n";
+    double return_sum = 0.0;
+    int successes = 0, window = 0;
+    while (!signals::stop_requested() && !node.training_done() &&
+           (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
+      const agent::EpisodeSummary s = node.run_one_episode();
+      return_sum += s.episode_return;
+      successes += s.success ? 1 : 0;
+      if (++window == report_every) {
+        std::cerr << "auv_actor " << config.actor_id << ": episodes " << node.counters().episodes
+                  << ", policy v" << node.policy_version() << ", beta " << node.beta_m()
+                  << " m, mean return " << return_sum / window << ", success "
+                  << successes << "/" << window << "\n";
+        return_sum = 0.0;
+        successes = window = 0;
+      }
+    }
+    const auto& c = node.counters();
+    std::cerr << "auv_actor " << config.actor_id << ": stopped after " << c.episodes
+              << " episodes, " << c.steps << " steps, " << c.transitions_sent
+              << " transitions sent, " << c.episodes_discarded << " discarded\n";
+  } catch (const std::exception& e) {
+    std::cerr << "auv_actor: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

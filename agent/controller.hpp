@@ -1,0 +1,44 @@
+// What decides the thrust: a learned policy (the paper's end-to-end agent) or the classical
+// PID baseline. Both see the same inputs and return normalised commands in [-1, 1].
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "common/nn/mlp.hpp"
+#include "common/task/task.hpp"
+
+namespace auvrl::agent {
+
+/// A controller for one vehicle. act() is called once per control step.
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  /// Called at the start of every episode.
+  virtual void reset() {}
+  /// Fills action (size num_thrusters, each in [-1, 1]) from the observation, the goal and the
+  /// task's observation vector built from them.
+  virtual void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
+                   const task::StateVector& state, task::ActionVector& action) = 0;
+  virtual std::string name() const = 0;
+};
+
+/// The learned policy mu(x | theta): the actor network on the task's observation vector.
+class PolicyController final : public Controller {
+ public:
+  /// Throws std::invalid_argument if the network's input/output sizes do not match.
+  PolicyController(nn::Mlp network, int state_dim, int num_thrusters);
+  void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector& state,
+           task::ActionVector& action) override;
+  std::string name() const override { return "policy"; }
+  /// Replaces the network (new weights from the learner); same size checks.
+  void set_network(nn::Mlp network);
+  const nn::Mlp& network() const { return network_; }
+
+ private:
+  nn::Mlp network_;
+  int state_dim_;
+  int num_thrusters_;
+};
+
+}  // namespace auvrl::agent

@@ -1,0 +1,135 @@
+#include "agent/episode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace auvrl::agent {
+
+ExplorationNoise::Kind parse_noise_kind(const std::string& name) {
+  if (name == "none") return ExplorationNoise::Kind::kNone;
+  if (name == "ou") return ExplorationNoise::Kind::kOrnsteinUhlenbeck;
+  if (name == "gaussian") return ExplorationNoise::Kind::kGaussian;
+  throw std::invalid_argument("noise '" + name + "': expected none, ou or gaussian");
+}
+
+ExplorationNoise::ExplorationNoise(Kind kind, int dim, double sigma, double theta,
+                                   std::uint64_t seed)
+    : kind_(kind), sigma_(sigma), theta_(theta), state_(Eigen::VectorXd::Zero(dim)), rng_(seed) {
+  if (!(sigma >= 0) || !(theta >= 0)) {
+    throw std::invalid_argument("exploration noise: sigma and theta must be >= 0");
+  }
+}
+
+void ExplorationNoise::reset() { state_.setZero(); }
+
+void ExplorationNoise::apply(task::ActionVector& action) {
+  if (kind_ == Kind::kNone) return;
+  for (Eigen::Index i = 0; i < action.size(); ++i) {
+    double n = 0.0;
+    if (kind_ == Kind::kGaussian) {
+      n = sigma_ * normal_(rng_);
+    } else {
+      // Ornstein-Uhlenbeck, dt = one step: x += theta (0 - x) + sigma N(0, 1).
+      state_[i] += -theta_ * state_[i] + sigma_ * normal_(rng_);
+      n = state_[i];
+    }
+    action[i] = static_cast<float>(std::clamp(static_cast<double>(action[i]) + n, -1.0, 1.0));
+  }
+}
+
+EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
+                           Controller& controller, const EpisodeOptions& options) {
+  const int n = link.num_thrusters();
+  if (n != task.num_thrusters) {
+    throw std::invalid_argument("the vehicle has " + std::to_string(n) +
+                                " thrusters, the task expects " +
+                                std::to_string(task.num_thrusters));
+  }
+  EpisodeSummary summary;
+  controller.reset();
+  if (options.noise) options.noise->reset();
+
+  std::optional<VehicleReport> report = link.reset(options.start);
+  if (!report) {
+    summary.end_reason = task::EndReason::kSimTimeout;
+    return summary;
+  }
+  const Eigen::Vector3d& goal = options.goal_ned_m;
+  task::ActionVector previous_action = task::ActionVector::Zero(n);
+  task::ActionVector action(n);
+  task::StateVector state, next_state;
+  task::build_state(task, report->observation, goal, previous_action, state);
+  double distance = (goal - report->observation.position_ned_m).norm();
+  summary.min_distance_m = distance;
+  std::vector<double> thrust_n(static_cast<std::size_t>(n));
+  double error_sum_after_reach = 0.0;
+  int steps_after_reach = 0;
+  bool task_ended = false;  // reached (when running the full time anyway)
+
+  for (int t = 1; t <= task.max_steps; ++t) {
+    controller.act(report->observation, goal, state, action);
+    if (options.noise) options.noise->apply(action);
+    for (int i = 0; i < n; ++i) {
+      thrust_n[static_cast<std::size_t>(i)] = static_cast<double>(action[i]) * task.max_thrust_n;
+    }
+    std::optional<VehicleReport> next = link.step(thrust_n);
+    if (!next) {
+      summary.end_reason = task::EndReason::kSimTimeout;
+      break;
+    }
+    if (next->blown_up || !next->observation.position_ned_m.allFinite()) {
+      summary.end_reason = task::EndReason::kBlowUp;
+      break;
+    }
+    const double next_distance = (goal - next->observation.position_ned_m).norm();
+    const task::StepOutcome outcome = task::evaluate_step(
+        task, distance, next_distance, task::is_flipped(task, next->observation.euler_rpy_rad),
+        action, options.beta_m, t);
+    task::build_state(task, next->observation, goal, action, next_state);
+
+    if (!task_ended) {
+      if (options.on_transition) {
+        Transition tr{state,          action, outcome.reward, next_state, outcome.terminal,
+                      next->observation.position_ned_m, t - 1};
+        options.on_transition(tr);
+      }
+      summary.episode_return += outcome.reward;
+    }
+    summary.length_steps = t;
+    summary.thrust_energy += static_cast<double>(action.squaredNorm()) / n;
+    summary.final_distance_m = next_distance;
+    summary.min_distance_m = std::min(summary.min_distance_m, next_distance);
+    if (summary.time_to_reach_s < 0 && next_distance <= options.reach_radius_m) {
+      summary.time_to_reach_s = t * task.control_step_s;
+    }
+    if (summary.time_to_reach_s >= 0) {
+      error_sum_after_reach += next_distance;
+      ++steps_after_reach;
+    }
+    if (outcome.inside_goal) summary.success = true;
+    if (options.trajectory) {
+      options.trajectory->push_back(
+          {next->time_s, next->observation, thrust_n, next->thrust_realised_n, next_distance});
+    }
+
+    report = std::move(next);
+    state.swap(next_state);
+    previous_action = action;
+    distance = next_distance;
+    if (outcome.done) {
+      const bool keep_going = options.run_full_time &&
+                              outcome.reason == task::EndReason::kReached && t < task.max_steps;
+      if (summary.end_reason == task::EndReason::kNone || !keep_going) {
+        summary.end_reason = outcome.reason;
+      }
+      if (!keep_going) break;
+      task_ended = true;
+    }
+  }
+  if (summary.end_reason == task::EndReason::kNone) summary.end_reason = task::EndReason::kTimeLimit;
+  if (steps_after_reach > 0) summary.mean_error_after_reach_m = error_sum_after_reach / steps_after_reach;
+  return summary;
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,95 @@
+// One episode of the goal-driven task against a vehicle link: reset, then per control step
+// build the state, ask the controller, add exploration noise, command the thrusters, observe,
+// reward. The training actor and the evaluation run this same code.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "agent/controller.hpp"
+#include "agent/vehicle_link.hpp"
+#include "common/task/task.hpp"
+
+namespace auvrl::agent {
+
+/// Exploration noise added to the controller's action (Algorithm 1, line 5 and 9).
+class ExplorationNoise {
+ public:
+  enum class Kind { kNone, kOrnsteinUhlenbeck, kGaussian };
+  /// OU as in Lillicrap et al.: theta 0.15, sigma 0.2, dt 1 per step; Gaussian: N(0, sigma).
+  ExplorationNoise(Kind kind, int dim, double sigma, double theta, std::uint64_t seed);
+  void reset();  ///< start of an episode (OU state to zero)
+  /// Adds noise to action in place and clips to [-1, 1].
+  void apply(task::ActionVector& action);
+  Kind kind() const { return kind_; }
+
+ private:
+  Kind kind_;
+  double sigma_;
+  double theta_;
+  Eigen::VectorXd state_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+};
+
+ExplorationNoise::Kind parse_noise_kind(const std::string& name);  ///< none | ou | gaussian
+
+/// One transition as the learner stores it.
+struct Transition {
+  task::StateVector state;
+  task::ActionVector action;
+  double reward = 0.0;
+  task::StateVector next_state;
+  bool terminal = false;
+  Eigen::Vector3d achieved_position_ned_m = Eigen::Vector3d::Zero();
+  int step_index = 0;
+};
+
+/// One control step as recorded for trajectories and plots.
+struct TrajectoryRow {
+  double time_s = 0.0;
+  task::Observation observation;
+  std::vector<double> thrust_command_n;
+  std::vector<double> thrust_realised_n;
+  double distance_m = 0.0;
+};
+
+/// What an episode did.
+struct EpisodeSummary {
+  double episode_return = 0.0;
+  int length_steps = 0;
+  bool success = false;             ///< ended inside beta (or, in hold mode, was ever inside)
+  double final_distance_m = 0.0;
+  double min_distance_m = 0.0;
+  double thrust_energy = 0.0;       ///< sum of mean squared normalised commands
+  task::EndReason end_reason = task::EndReason::kNone;
+  /// First time inside `reach_radius_m` (see EpisodeOptions), s; negative if never.
+  double time_to_reach_s = -1.0;
+  /// Mean distance to the goal from that moment to the end, m (0 if never reached).
+  double mean_error_after_reach_m = 0.0;
+};
+
+/// How to run an episode.
+struct EpisodeOptions {
+  Eigen::Vector3d goal_ned_m = Eigen::Vector3d::Zero();
+  double beta_m = 0.5;
+  EpisodeStart start;
+  /// Radius for time_to_reach_s / mean_error_after_reach_m (evaluation: 0.5 m).
+  double reach_radius_m = 0.5;
+  /// Keep running after the task would end by reaching (evaluation: the full 70 s to see the
+  /// vehicle hold station). Failures still end the episode.
+  bool run_full_time = false;
+  ExplorationNoise* noise = nullptr;  ///< none: the controller alone
+  /// Called with every transition (not for a blown-up step).
+  std::function<void(const Transition&)> on_transition;
+  std::vector<TrajectoryRow>* trajectory = nullptr;  ///< recorded when given
+};
+
+/// Runs one episode; returns nothing if the vehicle stopped answering (no transitions after
+/// that point were reported).
+EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
+                           Controller& controller, const EpisodeOptions& options);
+
+}  // namespace auvrl::agent

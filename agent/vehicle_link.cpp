@@ -1,0 +1,110 @@
+#include "agent/vehicle_link.hpp"
+
+#include "common/sim_client.hpp"
+
+namespace auvrl::agent {
+
+namespace {
+
+class InProcessLink final : public VehicleLink {
+ public:
+  explicit InProcessLink(const sim::VehicleModel& model) : model_(model) {}
+  int num_thrusters() const override { return model_.num_thrusters(); }
+
+  std::optional<VehicleReport> reset(const EpisodeStart& start) override {
+    sim::ResetSettings settings;
+    settings.eta << start.position_ned_m, start.euler_rpy_rad;
+    settings.thruster_efficiency = start.thruster_efficiency.empty()
+                                       ? sim::ThrusterVector::Ones(model_.num_thrusters())
+                                       : sim::ThrusterVector(Eigen::Map<const Eigen::VectorXd>(
+                                             start.thruster_efficiency.data(),
+                                             static_cast<Eigen::Index>(start.thruster_efficiency.size())));
+    settings.current.constant_velocity_ned_mps = start.current_ned_mps;
+    settings.seed = start.seed;
+    state_ = sim::make_state(model_, settings);
+    return report();
+  }
+
+  std::optional<VehicleReport> step(const std::vector<double>& thrust_n) override {
+    if (!state_) return std::nullopt;
+    command_ = Eigen::Map<const Eigen::VectorXd>(thrust_n.data(),
+                                                  static_cast<Eigen::Index>(thrust_n.size()));
+    sim::step(model_, *state_, command_);
+    return report();
+  }
+
+ private:
+  VehicleReport report() {
+    const sim::Measurement m = sim::measure(model_, *state_);
+    VehicleReport r;
+    r.observation.position_ned_m = m.eta.head<3>();
+    r.observation.euler_rpy_rad = m.eta.tail<3>();
+    r.observation.velocity_body_mps = m.nu.head<3>();
+    r.observation.angular_rate_body_rad_s = m.nu.tail<3>();
+    r.thrust_realised_n.assign(m.thrust_realised_n.data(),
+                               m.thrust_realised_n.data() + m.thrust_realised_n.size());
+    r.time_s = m.time_s;
+    r.blown_up = m.status != sim::StateStatus::kOk;
+    return r;
+  }
+
+  const sim::VehicleModel& model_;
+  std::optional<sim::VehicleState> state_;
+  sim::ThrusterVector command_;
+};
+
+class LockstepLink final : public VehicleLink {
+ public:
+  LockstepLink(transport::Transport& transport, int vehicle_id, int num_thrusters)
+      : client_(transport, vehicle_id), num_thrusters_(num_thrusters) {}
+  int num_thrusters() const override { return num_thrusters_; }
+
+  std::optional<VehicleReport> reset(const EpisodeStart& start) override {
+    auvrl_lcm::vehicle_reset_t msg{};
+    for (int i = 0; i < 3; ++i) {
+      msg.position_ned_m[i] = start.position_ned_m[i];
+      msg.euler_rpy_rad[i] = start.euler_rpy_rad[i];
+      msg.current_constant_ned_mps[i] = start.current_ned_mps[i];
+    }
+    msg.num_thrusters = static_cast<std::int8_t>(start.thruster_efficiency.size());
+    msg.thruster_efficiency = start.thruster_efficiency;
+    msg.seed = static_cast<std::int64_t>(start.seed);
+    return convert(client_.reset(msg));
+  }
+
+  std::optional<VehicleReport> step(const std::vector<double>& thrust_n) override {
+    return convert(client_.step(thrust_n));
+  }
+
+ private:
+  std::optional<VehicleReport> convert(const std::optional<auvrl_lcm::vehicle_state_t>& s) const {
+    if (!s || s->num_thrusters != num_thrusters_) return std::nullopt;
+    VehicleReport r;
+    for (int i = 0; i < 3; ++i) {
+      r.observation.position_ned_m[i] = s->position_ned_m[i];
+      r.observation.euler_rpy_rad[i] = s->euler_rpy_rad[i];
+      r.observation.velocity_body_mps[i] = s->velocity_body_mps[i];
+      r.observation.angular_rate_body_rad_s[i] = s->angular_rate_body_rad_s[i];
+    }
+    r.thrust_realised_n = s->thrust_realised_n;
+    r.time_s = s->sim_time_s;
+    r.blown_up = s->status != auvrl_lcm::vehicle_state_t::STATUS_OK;
+    return r;
+  }
+
+  SimClient client_;
+  int num_thrusters_;
+};
+
+}  // namespace
+
+std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model) {
+  return std::make_unique<InProcessLink>(model);
+}
+
+std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
+                                                int num_thrusters) {
+  return std::make_unique<LockstepLink>(transport, vehicle_id, num_thrusters);
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,50 @@
+// How an episode reaches its vehicle: over LCM in lockstep with auv_sim (training actors), or
+// directly through the dynamics library in this process (evaluation, tests). The episode code
+// above it is the same either way.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/task/task.hpp"
+#include "common/transport.hpp"
+#include "sim/dynamics.hpp"
+
+namespace auvrl::agent {
+
+/// What the vehicle reports after a reset or a step.
+struct VehicleReport {
+  task::Observation observation;
+  std::vector<double> thrust_realised_n;  ///< per thruster, N
+  double time_s = 0.0;                     ///< since the reset, s
+  bool blown_up = false;                   ///< the simulator flagged a numerical blow-up
+};
+
+/// Initial conditions and faults of an episode.
+struct EpisodeStart {
+  Eigen::Vector3d position_ned_m{0.0, 0.0, 5.0};
+  Eigen::Vector3d euler_rpy_rad = Eigen::Vector3d::Zero();
+  std::vector<double> thruster_efficiency;  ///< empty: all healthy
+  Eigen::Vector3d current_ned_mps = Eigen::Vector3d::Zero();
+  std::uint64_t seed = 1;
+};
+
+/// A vehicle an episode can reset and command. Returns nothing when the vehicle did not answer.
+class VehicleLink {
+ public:
+  virtual ~VehicleLink() = default;
+  virtual int num_thrusters() const = 0;
+  virtual std::optional<VehicleReport> reset(const EpisodeStart& start) = 0;
+  virtual std::optional<VehicleReport> step(const std::vector<double>& thrust_n) = 0;
+};
+
+/// The dynamics library in this process (deterministic, no transport).
+std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model);
+
+/// One vehicle of auv_sim over the transport, in lockstep.
+std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
+                                                int num_thrusters);
+
+}  // namespace auvrl::agent

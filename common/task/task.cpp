@@ -1,0 +1,195 @@
+#include "common/task/task.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace auvrl::task {
+
+namespace {
+constexpr int kPaperFixed = 3 + 3 + 6;         // x_pos, x_e, v
+constexpr int kExtendedFixed = 3 + 1 + 6 + 6 + 1;  // e_body, d, sin/cos, v, depth
+// Offsets of the extended layout.
+constexpr int kExtError = 0, kExtDistance = 3, kExtTrig = 4, kExtVelocity = 10, kExtAction = 16;
+// Offsets of the paper layout.
+constexpr int kPaperPosition = 0, kPaperError = 3, kPaperVelocity = 6, kPaperAction = 12;
+}  // namespace
+
+StateLayout parse_layout(const std::string& name) {
+  if (name == "paper") return StateLayout::kPaper;
+  if (name == "extended") return StateLayout::kExtended;
+  throw std::invalid_argument("state layout '" + name + "': expected paper or extended");
+}
+
+const char* to_string(StateLayout layout) {
+  return layout == StateLayout::kPaper ? "paper" : "extended";
+}
+
+RewardKind parse_reward_kind(const std::string& name) {
+  if (name == "paper") return RewardKind::kPaper;
+  if (name == "shaped") return RewardKind::kShaped;
+  throw std::invalid_argument("reward '" + name + "': expected paper or shaped");
+}
+
+const char* to_string(RewardKind kind) { return kind == RewardKind::kPaper ? "paper" : "shaped"; }
+
+int TaskConfig::state_dim() const {
+  return (layout == StateLayout::kPaper ? kPaperFixed : kExtendedFixed) + num_thrusters;
+}
+
+void TaskConfig::validate() const {
+  const auto positive = [](double v, const char* name) {
+    if (!std::isfinite(v) || v <= 0) {
+      throw std::invalid_argument(std::string("task.") + name + " must be finite and > 0");
+    }
+  };
+  positive(scales.position_m, "scales.position_m");
+  positive(scales.linear_velocity_mps, "scales.linear_velocity_mps");
+  positive(scales.angular_rate_rad_s, "scales.angular_rate_rad_s");
+  positive(scales.depth_m, "scales.depth_m");
+  positive(max_thrust_n, "max_thrust_n");
+  positive(beta_max_m, "beta_max_m");
+  positive(flip_angle_rad, "flip_angle_rad");
+  positive(control_step_s, "control_step_s");
+  if (num_thrusters < 1 || num_thrusters > 64) {
+    throw std::invalid_argument("task.num_thrusters must be in 1..64");
+  }
+  if (max_steps < 1) throw std::invalid_argument("task.max_steps must be >= 1");
+  for (double v : {goal_reward, step_penalty, thrust_weight, failure_reward, progress_weight,
+                   hold_reward_per_step, start_yaw_rad}) {
+    if (!std::isfinite(v)) throw std::invalid_argument("task: a reward constant is not finite");
+  }
+  if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
+      !goal_max_ned_m.allFinite() || (goal_max_ned_m - goal_min_ned_m).minCoeff() < 0) {
+    throw std::invalid_argument("task: goal region must be finite with min <= max");
+  }
+}
+
+Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& e) {
+  const double cphi = std::cos(e[0]), sphi = std::sin(e[0]);
+  const double cth = std::cos(e[1]), sth = std::sin(e[1]);
+  const double cpsi = std::cos(e[2]), spsi = std::sin(e[2]);
+  Eigen::Matrix3d r;
+  r << cpsi * cth, -spsi * cphi + cpsi * sth * sphi, spsi * sphi + cpsi * cphi * sth,  //
+      spsi * cth, cpsi * cphi + sphi * sth * spsi, -cpsi * sphi + sth * spsi * cphi,   //
+      -sth, cth * sphi, cth * cphi;
+  return r;
+}
+
+void build_state(const TaskConfig& c, const Observation& obs, const Eigen::Vector3d& goal,
+                 const ActionVector& previous_action, StateVector& out) {
+  if (previous_action.size() != c.num_thrusters) {
+    throw std::invalid_argument("build_state: previous action has " +
+                                std::to_string(previous_action.size()) + " entries, expected " +
+                                std::to_string(c.num_thrusters));
+  }
+  out.resize(c.state_dim());
+  const Eigen::Vector3d error_ned = goal - obs.position_ned_m;
+  const ObservationScales& k = c.scales;
+  if (c.layout == StateLayout::kPaper) {
+    out.segment<3>(kPaperPosition) = (obs.position_ned_m / k.position_m).cast<float>();
+    out.segment<3>(kPaperError) = (error_ned / k.position_m).cast<float>();
+    out.segment<3>(kPaperVelocity) = (obs.velocity_body_mps / k.linear_velocity_mps).cast<float>();
+    out.segment<3>(kPaperVelocity + 3) =
+        (obs.angular_rate_body_rad_s / k.angular_rate_rad_s).cast<float>();
+    out.segment(kPaperAction, c.num_thrusters) = previous_action;
+    return;
+  }
+  const Eigen::Vector3d error_body = body_to_ned(obs.euler_rpy_rad).transpose() * error_ned;
+  out.segment<3>(kExtError) = (error_body / k.position_m).cast<float>();
+  out[kExtDistance] = static_cast<float>(error_ned.norm() / k.position_m);
+  for (int i = 0; i < 3; ++i) {
+    out[kExtTrig + 2 * i] = static_cast<float>(std::sin(obs.euler_rpy_rad[i]));
+    out[kExtTrig + 2 * i + 1] = static_cast<float>(std::cos(obs.euler_rpy_rad[i]));
+  }
+  out.segment<3>(kExtVelocity) = (obs.velocity_body_mps / k.linear_velocity_mps).cast<float>();
+  out.segment<3>(kExtVelocity + 3) =
+      (obs.angular_rate_body_rad_s / k.angular_rate_rad_s).cast<float>();
+  out.segment(kExtAction, c.num_thrusters) = previous_action;
+  out[kExtAction + c.num_thrusters] = static_cast<float>(obs.position_ned_m[2] / k.depth_m);
+}
+
+namespace {
+/// Body-to-NED rotation from the sin/cos entries of an extended observation vector.
+Eigen::Matrix3d rotation_from_state(const Eigen::Ref<const StateVector>& state) {
+  Eigen::Vector3d euler;
+  for (int i = 0; i < 3; ++i) {
+    euler[i] = std::atan2(state[kExtTrig + 2 * i], state[kExtTrig + 2 * i + 1]);
+  }
+  return body_to_ned(euler);
+}
+}  // namespace
+
+void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
+                   const Eigen::Vector3d& new_goal, Eigen::Ref<StateVector> state) {
+  const Eigen::Vector3d shift = new_goal - old_goal;
+  if (c.layout == StateLayout::kPaper) {
+    state.segment<3>(kPaperError) += (shift / c.scales.position_m).cast<float>();
+    return;
+  }
+  const Eigen::Matrix3d r = rotation_from_state(state);
+  Eigen::Vector3d error_body = state.segment<3>(kExtError).cast<double>() * c.scales.position_m;
+  error_body += r.transpose() * shift;
+  state.segment<3>(kExtError) = (error_body / c.scales.position_m).cast<float>();
+  state[kExtDistance] = static_cast<float>(error_body.norm() / c.scales.position_m);
+}
+
+Eigen::Vector3d position_from_state(const TaskConfig& c, const Eigen::Vector3d& goal,
+                                    const Eigen::Ref<const StateVector>& state) {
+  if (c.layout == StateLayout::kPaper) {
+    return state.segment<3>(kPaperPosition).cast<double>() * c.scales.position_m;
+  }
+  const Eigen::Vector3d error_body = state.segment<3>(kExtError).cast<double>() * c.scales.position_m;
+  return goal - rotation_from_state(state) * error_body;
+}
+
+double thrust_cost(const TaskConfig& c, const ActionVector& action) {
+  return c.thrust_weight * static_cast<double>(action.squaredNorm()) /
+         static_cast<double>(std::max<Eigen::Index>(1, action.size()));
+}
+
+bool is_flipped(const TaskConfig& c, const Eigen::Vector3d& euler) {
+  return std::abs(euler[0]) > c.flip_angle_rad || std::abs(euler[1]) > c.flip_angle_rad;
+}
+
+StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, bool flipped,
+                          const ActionVector& action, double beta_m, int steps_taken) {
+  StepOutcome out;
+  out.distance_m = d_after;
+  out.inside_goal = d_after <= beta_m;
+  if (flipped || d_after > c.beta_max_m) {
+    out.reward = c.failure_reward;
+    out.terminal = out.done = true;
+    out.reason = flipped ? EndReason::kFlipped : EndReason::kLeftRegion;
+    return out;
+  }
+  const double cost = thrust_cost(c, action);
+  if (out.inside_goal && !c.hold_mode) {
+    out.reward = c.goal_reward;
+    out.terminal = out.done = true;
+    out.reason = EndReason::kReached;
+    return out;
+  }
+  if (c.reward == RewardKind::kPaper) {
+    out.reward = -c.step_penalty - cost;
+  } else {
+    out.reward = c.progress_weight * (d_before - d_after) - c.step_penalty - cost;
+  }
+  if (out.inside_goal) out.reward += c.hold_reward_per_step;  // hold mode only
+  if (steps_taken >= c.max_steps) {
+    out.done = true;  // a cut-off: the learner bootstraps through it
+    out.reason = EndReason::kTimeLimit;
+  }
+  return out;
+}
+
+Eigen::Vector3d sample_goal(const TaskConfig& c, std::mt19937_64& rng) {
+  Eigen::Vector3d g;
+  for (int i = 0; i < 3; ++i) {
+    // Portable draw (std::uniform_real_distribution differs between libraries).
+    const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
+    g[i] = c.goal_min_ned_m[i] + u * (c.goal_max_ned_m[i] - c.goal_min_ned_m[i]);
+  }
+  return g;
+}
+
+}  // namespace auvrl::task

@@ -1,0 +1,153 @@
+// The paper's goal-driven task (section IV-A, Eq. 13-14), in one place for actors, learner
+// (hindsight relabelling) and evaluation: what the agent observes, what it is rewarded, when
+// an episode ends, and where the way-points come from.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <random>
+#include <string>
+
+namespace auvrl::task {
+
+/// Which observation vector the networks see.
+enum class StateLayout {
+  /// The paper: x_t = [x_pos, x_e, v_t, u_t-1] with x_e = x_ref - x_pos (NED, scaled), v_t the
+  /// six body velocities, u_t-1 the previous action: 3 + 3 + 6 + n values. It has no attitude,
+  /// so a goal behind the vehicle (test 2) is only partially observable.
+  kPaper,
+  /// What a vehicle needs to act on a goal it may face away from: goal error in the body
+  /// frame, distance, sin/cos of roll, pitch and yaw, body velocities, previous action, depth:
+  /// 3 + 1 + 6 + 6 + n + 1 values.
+  kExtended,
+};
+
+StateLayout parse_layout(const std::string& name);  ///< "paper" or "extended"
+const char* to_string(StateLayout layout);
+
+/// Which reward function.
+enum class RewardKind {
+  /// Eq. 14: +goal_reward when d <= beta; -step_penalty - thrust_weight f(u) otherwise;
+  /// failure_reward when d > beta_max (or the vehicle flips).
+  kPaper,
+  /// Dense: progress_weight (d_before - d_after) - step_penalty - thrust_weight f(u), the same
+  /// goal and failure rewards. Learns much faster (shared/reference/learning_notes.md).
+  kShaped,
+};
+
+RewardKind parse_reward_kind(const std::string& name);  ///< "paper" or "shaped"
+const char* to_string(RewardKind kind);
+
+/// Fixed scales that bring every input to roughly [-1, 1] (documented in the README).
+struct ObservationScales {
+  double position_m = 10.0;       ///< positions and goal errors
+  double linear_velocity_mps = 1.0;
+  double angular_rate_rad_s = 1.0;
+  double depth_m = 10.0;
+};
+
+/// Every constant of the task. Defaults are the paper's where it gives one.
+struct TaskConfig {
+  StateLayout layout = StateLayout::kPaper;
+  ObservationScales scales;
+  int num_thrusters = 6;
+  double max_thrust_n = 39.24;  ///< action +-1 maps to +-this, N
+
+  RewardKind reward = RewardKind::kPaper;
+  double goal_reward = 10.0;      ///< on reaching the goal radius beta
+  double step_penalty = 1.0;      ///< the "-1" of Eq. 14, per step
+  /// f(Tr) = thrust_weight * mean(u_i^2) with u the normalised command in [-1, 1]: the paper
+  /// weights thruster usage without giving f; a quadratic cost is the usual energy proxy.
+  double thrust_weight = 0.1;
+  /// Reward when the episode fails (d > beta_max or flipped). The paper's -10 makes ending the
+  /// episode early optimal while success is rare; -1/(1 - gamma) = -100 removes that.
+  double failure_reward = -10.0;
+  double progress_weight = 10.0;  ///< shaped reward: per metre of progress toward the goal
+  double beta_max_m = 20.0;       ///< safety sphere around the goal, m
+  double flip_angle_rad = 1.2;    ///< |roll| or |pitch| beyond this ends the episode
+  /// Hold mode: reaching does not end the episode; every step inside beta earns
+  /// hold_reward_per_step instead, so the agent learns to stay (evaluation demands holding).
+  bool hold_mode = false;
+  double hold_reward_per_step = 1.0;
+
+  int max_steps = 700;            ///< 70 s of 0.1 s steps: a cut-off, not a terminal state
+  double control_step_s = 0.1;
+
+  Eigen::Vector3d start_position_ned_m{0.0, 0.0, 5.0};
+  double start_yaw_rad = 0.0;
+  /// Way-points are drawn uniformly in this box (NED, absolute), m.
+  Eigen::Vector3d goal_min_ned_m{-10.0, -10.0, 1.0};
+  Eigen::Vector3d goal_max_ned_m{10.0, 10.0, 15.0};
+
+  /// Size of the observation vector.
+  int state_dim() const;
+  /// Throws std::invalid_argument naming the first unusable value.
+  void validate() const;
+};
+
+/// What the vehicle reports, as the task uses it.
+struct Observation {
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d euler_rpy_rad = Eigen::Vector3d::Zero();  ///< roll, pitch, yaw (ZYX)
+  Eigen::Vector3d velocity_body_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_rate_body_rad_s = Eigen::Vector3d::Zero();
+};
+
+using StateVector = Eigen::VectorXf;
+using ActionVector = Eigen::VectorXf;  ///< normalised commands in [-1, 1]
+
+/// Rotation from body to NED for ZYX Euler angles (Fossen's R(Theta)).
+Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& euler_rpy_rad);
+
+/// The observation vector for the layout (size config.state_dim()).
+void build_state(const TaskConfig& config, const Observation& obs,
+                 const Eigen::Vector3d& goal_ned_m, const ActionVector& previous_action,
+                 StateVector& out);
+
+/// Rewrites a stored observation vector for another goal (hindsight relabelling): only the
+/// goal-dependent entries change (x_e; or body-frame error and distance).
+void relabel_state(const TaskConfig& config, const Eigen::Vector3d& old_goal_ned_m,
+                   const Eigen::Vector3d& new_goal_ned_m, Eigen::Ref<StateVector> state);
+
+/// Vehicle position encoded in an observation vector built for goal_ned_m.
+Eigen::Vector3d position_from_state(const TaskConfig& config, const Eigen::Vector3d& goal_ned_m,
+                                    const Eigen::Ref<const StateVector>& state);
+
+/// Why an episode ended (values of episode_report_t.end_reason).
+enum class EndReason : int {
+  kNone = -1,
+  kReached = 0,
+  kTimeLimit = 1,
+  kLeftRegion = 2,
+  kFlipped = 3,
+  kBlowUp = 4,
+  kSimTimeout = 5,
+};
+
+/// The outcome of one step.
+struct StepOutcome {
+  double reward = 0.0;
+  bool terminal = false;  ///< the task ended: do not bootstrap from the next state
+  bool done = false;      ///< the episode ends (terminal, or the time limit cut it off)
+  bool inside_goal = false;
+  double distance_m = 0.0;
+  EndReason reason = EndReason::kNone;
+};
+
+/// f(Tr): the thrust cost of one step's normalised action.
+double thrust_cost(const TaskConfig& config, const ActionVector& action);
+
+/// True when roll or pitch is beyond the flip angle (Euler angles are singular at 90 deg).
+bool is_flipped(const TaskConfig& config, const Eigen::Vector3d& euler_rpy_rad);
+
+/// Reward and termination of one transition, from the distances to the goal before and after
+/// it, whether the vehicle flipped, the action and the goal radius. steps_taken counts this
+/// step (the time limit cuts the episode off at config.max_steps).
+StepOutcome evaluate_step(const TaskConfig& config, double distance_before_m,
+                          double distance_after_m, bool flipped, const ActionVector& action,
+                          double beta_m, int steps_taken);
+
+/// Draws a way-point uniformly in the configured box.
+Eigen::Vector3d sample_goal(const TaskConfig& config, std::mt19937_64& rng);
+
+}  // namespace auvrl::task
