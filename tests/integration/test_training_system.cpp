@@ -1,0 +1,91 @@
+// The training system as real processes in a private network namespace: auv_sim serving two
+// vehicles, auv_learner, two auv_actor processes. Both actors report episodes, the learner's
+// buffer fills, and both actors act with rising policy versions.
+#include <gtest/gtest.h>
+
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
+#include <map>
+
+#include "child_process.hpp"
+#include "common/channels.hpp"
+#include "common/transport.hpp"
+
+namespace {
+
+using namespace auvrl;
+using test_support::ChildProcess;
+
+TEST(TrainingSystem, SimTwoActorsAndLearnerTrainTogether) {
+  const std::string dir = test_support::make_temp_dir("auvrl_training_system_");
+  auto monitor = transport::make_transport({});
+  std::map<int, std::vector<auvrl_lcm::episode_report_t>> episodes;
+  transport::subscribe<auvrl_lcm::episode_report_t>(
+      *monitor, channels::kEpisode,
+      [&](const std::string&, const auvrl_lcm::episode_report_t& r) {
+        episodes[r.actor_id].push_back(r);
+      });
+  std::vector<auvrl_lcm::learner_stats_t> stats;
+  transport::subscribe<auvrl_lcm::learner_stats_t>(
+      *monitor, channels::kLearnerStats,
+      [&](const std::string&, const auvrl_lcm::learner_stats_t& s) { stats.push_back(s); });
+
+  ChildProcess sim({test_support::bin_path("auv_sim"), "--vehicles", "2"}, dir + "/sim.log");
+  ChildProcess learner({test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden",
+                        "32-32", "--batch", "64", "--state-dim", "23", "--replay", "100000",
+                        "--updates-per-transition", "0.25", "--warmup", "500"},
+                       dir + "/learner.log");
+  std::vector<std::unique_ptr<ChildProcess>> actors;
+  for (int id = 0; id < 2; ++id) {
+    actors.push_back(std::make_unique<ChildProcess>(
+        std::vector<std::string>{test_support::bin_path("auv_actor"), "--actor-id",
+                                 std::to_string(id), "--seed", std::to_string(10 + id),
+                                 "--reward", "shaped", "--max-steps", "100", "--noise",
+                                 "gaussian"},
+        dir + "/actor" + std::to_string(id) + ".log"));
+  }
+
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(40);
+  const auto enough = [&] {
+    if (stats.empty() || stats.back().buffer_size < 5000 || stats.back().updates < 500) {
+      return false;
+    }
+    for (int id = 0; id < 2; ++id) {
+      const auto& list = episodes[id];
+      if (list.size() < 30 || list.back().policy_version <= list.front().policy_version) {
+        return false;
+      }
+    }
+    return true;
+  };
+  while (std::chrono::steady_clock::now() < deadline && !enough()) monitor->handle(100);
+
+  const std::string logs = "learner:\n" + learner.log() + "actor 0:\n" + actors[0]->log() +
+                           "actor 1:\n" + actors[1]->log() + "sim:\n" + sim.log();
+  ASSERT_FALSE(stats.empty()) << logs;
+  const auvrl_lcm::learner_stats_t& last = stats.back();
+  EXPECT_GE(last.buffer_size, 5000) << logs;
+  EXPECT_GE(last.updates, 500);
+  EXPECT_EQ(last.batches_dropped, 0);
+  EXPECT_EQ(last.batches_lost, 0);
+  EXPECT_GE(last.episodes, 60);
+  for (int id = 0; id < 2; ++id) {
+    const auto& list = episodes[id];
+    ASSERT_GE(list.size(), 30u) << "actor " << id << " reported too few episodes\n" << logs;
+    EXPECT_GT(list.back().policy_version, list.front().policy_version)
+        << "actor " << id << " did not pick up new weights";
+    EXPECT_GT(list.back().policy_version, 0);
+    for (std::size_t i = 1; i < list.size(); ++i) {
+      EXPECT_EQ(list[i].episode_id, list[i - 1].episode_id + 1) << "an episode report was lost";
+      EXPECT_GE(list[i].policy_version, list[i - 1].policy_version) << "policy went backwards";
+    }
+  }
+  for (auto& actor : actors) {
+    const int status = actor->terminate();
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << actor->log();
+  }
+  EXPECT_EQ(learner.terminate(), 0) << learner.log();
+  EXPECT_EQ(sim.terminate(), 0) << sim.log();
+}
+
+}  // namespace
