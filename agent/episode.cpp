@@ -38,6 +38,16 @@ void ExplorationNoise::apply(task::ActionVector& action) {
   }
 }
 
+namespace {
+/// A report the task can use: a NaN or infinity anywhere (not only in the position) would
+/// otherwise reach the state vector and the learner's replay buffer.
+bool usable(const VehicleReport& r) {
+  const task::Observation& o = r.observation;
+  return !r.blown_up && o.position_ned_m.allFinite() && o.euler_rpy_rad.allFinite() &&
+         o.velocity_body_mps.allFinite() && o.angular_rate_body_rad_s.allFinite();
+}
+}  // namespace
+
 EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
                            Controller& controller, const EpisodeOptions& options) {
   const int n = link.num_thrusters();
@@ -53,6 +63,10 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
   std::optional<VehicleReport> report = link.reset(options.start);
   if (!report) {
     summary.end_reason = task::EndReason::kSimTimeout;
+    return summary;
+  }
+  if (!usable(*report)) {
+    summary.end_reason = task::EndReason::kBlowUp;
     return summary;
   }
   const Eigen::Vector3d& goal = options.goal_ned_m;
@@ -78,7 +92,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
       summary.end_reason = task::EndReason::kSimTimeout;
       break;
     }
-    if (next->blown_up || !next->observation.position_ned_m.allFinite()) {
+    if (!usable(*next)) {
       summary.end_reason = task::EndReason::kBlowUp;
       break;
     }

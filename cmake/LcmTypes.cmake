@@ -26,7 +26,8 @@ function(auvrl_lcm_types)
   add_custom_target(${ARG_TARGET}_gen DEPENDS ${hpp_files})
   add_library(${ARG_TARGET} INTERFACE)
   add_dependencies(${ARG_TARGET} ${ARG_TARGET}_gen)
-  target_include_directories(${ARG_TARGET} INTERFACE ${gen_dir}/cpp)
+  # SYSTEM: lcm-gen 1.3.1's C++ for nested struct members fails -Wpedantic; not our code.
+  target_include_directories(${ARG_TARGET} SYSTEM INTERFACE ${gen_dir}/cpp)
 
   set(lcm_jar /usr/share/java/lcm.jar)
   if(ARG_JAR AND Java_JAVAC_EXECUTABLE AND Java_JAR_EXECUTABLE AND EXISTS ${lcm_jar})

@@ -28,6 +28,8 @@ inline const std::string kWeightsRequest = "WEIGHTS_REQUEST";
 inline const std::string kLearnerStats = "LEARNER_STATS";
 /// One finished episode of an actor (episode_report_t).
 inline const std::string kEpisode = "EPISODE";
+/// auv_logger's heartbeat (logger_heartbeat_t).
+inline const std::string kLoggerHeartbeat = "LOGGER_HEARTBEAT";
 
 /// Regexes auv_sim subscribes to (all vehicle ids; the id is parsed and checked).
 inline const std::string kSimCommandPattern = "SIM_CMD_[0-9]+";

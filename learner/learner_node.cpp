@@ -38,7 +38,11 @@ constexpr std::uint32_t kCheckpointVersion = 1;
 
 LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transport,
                          std::ostream& log)
-    : config_(std::move(config)), transport_(transport), log_(log) {
+    : config_(std::move(config)),
+      transport_(transport),
+      log_(log),
+      sample_rng_(config_.ddpg.seed ^ 0x5851F42D4C957F2Dull),
+      batch_(config_.ddpg.state_dim, config_.ddpg.action_dim, std::max(1, config_.ddpg.batch_size)) {
   config_.ddpg.validate();
   if (config_.updates_per_transition < 0 || !std::isfinite(config_.updates_per_transition)) {
     throw std::invalid_argument("updates_per_transition must be finite and >= 0");
@@ -50,6 +54,16 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
   ddpg_ = std::make_unique<Ddpg>(config_.ddpg);
   replay_ = std::make_unique<ReplayBuffer>(config_.ddpg.state_dim, config_.ddpg.action_dim,
                                            config_.ddpg.replay_capacity);
+  if (config_.her) {
+    if (config_.task.state_dim() != config_.ddpg.state_dim ||
+        config_.task.num_thrusters != config_.ddpg.action_dim) {
+      throw std::invalid_argument("her: the task's state/action sizes (" +
+                                  std::to_string(config_.task.state_dim()) + ", " +
+                                  std::to_string(config_.task.num_thrusters) +
+                                  ") differ from the learner's");
+    }
+    her_ = std::make_unique<HindsightRelabeler>(config_.task, config_.her_k);
+  }
   last_batch_seq_.assign(static_cast<std::size_t>(config_.max_actors), -1);
 
   using transport::subscribe;
@@ -148,7 +162,11 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
             (static_cast<std::uint64_t>(msg.episode_id[static_cast<std::size_t>(i)]) &
              ((std::uint64_t{1} << 40) - 1)),
         static_cast<std::uint32_t>(msg.step_index[static_cast<std::size_t>(i)])};
+    const std::size_t slot = replay_->next_slot();
+    const bool overwrote = replay_->size() == replay_->capacity();
+    const std::uint64_t overwritten_episode = overwrote ? replay_->episode_id(slot) : 0;
     replay_->add(t);
+    if (her_) her_->on_add(*replay_, slot, overwrote, overwritten_episode);
     if (replay_->size() > threshold) credit += config_.updates_per_transition;
   }
   counters_.transitions_received += n;
@@ -177,7 +195,14 @@ void LearnerNode::run_updates() {
   int done = 0;
   while (update_credit_ >= 1.0 && replay_->size() > threshold && done < config_.max_updates_per_poll &&
          !training_done()) {
-    const UpdateStats stats = ddpg_->update(*replay_);
+    UpdateStats stats;
+    if (her_) {
+      replay_->sample(sample_rng_, config_.ddpg.batch_size, batch_);
+      her_->relabel(*replay_, beta_m(), sample_rng_, batch_);
+      stats = ddpg_->update(batch_);
+    } else {
+      stats = ddpg_->update(*replay_);
+    }
     update_credit_ -= 1.0;
     ++done;
     ++interval_updates_;
@@ -285,6 +310,7 @@ void LearnerNode::save(nn::Writer& w) const {
   w.f64(update_credit_);
   w.u32(static_cast<std::uint32_t>(last_batch_seq_.size()));
   for (std::int64_t seq : last_batch_seq_) w.u64(static_cast<std::uint64_t>(seq));
+  nn::write_rng(w, sample_rng_);
   ddpg_->save(w);
   replay_->save(w);
 }
@@ -325,6 +351,8 @@ void LearnerNode::resume() {
         if (actors > 1000000) r.fail("implausible actor count " + std::to_string(actors));
         std::vector<std::int64_t> seqs(actors);
         for (auto& s : seqs) s = static_cast<std::int64_t>(r.u64());
+        nn::Rng sample_rng;
+        nn::read_rng(r, sample_rng);
         auto ddpg = std::make_unique<Ddpg>(config_.ddpg);
         ddpg->restore(r);
         auto replay = std::make_unique<ReplayBuffer>(
@@ -338,6 +366,8 @@ void LearnerNode::resume() {
         update_credit_ = std::clamp(credit, 0.0, config_.max_update_backlog);
         seqs.resize(static_cast<std::size_t>(config_.max_actors), -1);
         last_batch_seq_ = std::move(seqs);
+        sample_rng_ = sample_rng;
+        if (her_) her_->rebuild(*replay_);
       },
       log_);
   broadcast_requested_ = true;

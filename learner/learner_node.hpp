@@ -17,7 +17,9 @@
 
 #include "common/task/goal_schedule.hpp"
 #include "common/transport.hpp"
+#include "common/task/task.hpp"
 #include "learner/ddpg.hpp"
+#include "learner/hindsight.hpp"
 #include "learner/replay_buffer.hpp"
 
 namespace auvrl::learner {
@@ -47,6 +49,11 @@ struct LearnerNodeConfig {
   double stats_period_s = 1.0;
 
   task::GoalSchedule schedule;         ///< beta from the episode count
+  /// Hindsight relabelling ("future" strategy) of sampled minibatches with the task's reward;
+  /// needs `task` to be the actors' task configuration.
+  bool her = false;
+  int her_k = 4;  ///< future goals per real one
+  task::TaskConfig task;
   std::int64_t max_episodes = 0;       ///< training ends after this many episodes (0: never)
   std::int64_t max_updates = 0;        ///< or after this many updates (0: never)
 
@@ -121,6 +128,9 @@ class LearnerNode {
   std::ostream& log_;
   std::unique_ptr<Ddpg> ddpg_;
   std::unique_ptr<ReplayBuffer> replay_;
+  std::unique_ptr<HindsightRelabeler> her_;
+  nn::Rng sample_rng_;  ///< minibatches when relabelling (otherwise the algorithm samples)
+  Batch batch_;
   LearnerCounters counters_;
   transport::DecodeStats decode_stats_;
   std::vector<transport::SubscriptionId> subscriptions_;

@@ -1,7 +1,12 @@
 // Lockstep control steps per second over LCM: auv_sim as a real process, one client, then two
-// client processes at once, each driving its own vehicle. Prints one line per case:
-//   lockstep clients=1 steps=N steps_per_s=X p50_us=.. p99_us=..
+// client processes at once, each driving its own vehicle; first with the processes placed by
+// the scheduler, then with all of them pinned to one CPU. Prints one line per client:
+//   lockstep placement=any clients=1 client=0 steps=N steps_per_s=X p50_us=.. p99_us=..
+// Pinning matters on virtual machines: a wake-up on another CPU costs an inter-processor
+// interrupt, and a lockstep round trip is four wake-ups (LCM hands every datagram from its
+// receive thread to the handling thread).
 // Run it inside a private network namespace: scripts/netns.sh build/bin/bench_lockstep
+#include <sched.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -58,10 +63,10 @@ ClientResult run_client(int vehicle_id, int steps) {
   return result;
 }
 
-void print(int clients, int index, int steps, const ClientResult& r) {
-  std::printf("lockstep clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f p99_us=%.1f "
-              "failures=%d\n",
-              clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
+void print(const char* placement, int clients, int index, int steps, const ClientResult& r) {
+  std::printf("lockstep placement=%s clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f "
+              "p99_us=%.1f failures=%d\n",
+              placement, clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
   std::fflush(stdout);
 }
 
@@ -79,20 +84,31 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << "\n";
     return 2;
   }
-  test_support::ChildProcess sim({test_support::bin_path("auv_sim"), "--vehicle", vehicle, "--vehicles",
-                             "2"});
-  print(1, 0, steps, run_client(0, steps));
-
-  // Two client processes at once, each on its own vehicle; each prints its own line.
-  std::vector<pid_t> children;
-  for (int id = 0; id < 2; ++id) {
-    const pid_t pid = fork();
-    if (pid == 0) {
-      print(2, id, steps, run_client(id, steps));
-      _exit(0);
+  cpu_set_t all;
+  sched_getaffinity(0, sizeof all, &all);
+  for (const char* placement : {"any", "cpu0"}) {
+    if (std::string(placement) == "cpu0") {
+      cpu_set_t one;
+      CPU_ZERO(&one);
+      CPU_SET(0, &one);
+      sched_setaffinity(0, sizeof one, &one);  // inherited by auv_sim and the clients
     }
-    children.push_back(pid);
+    test_support::ChildProcess sim(
+        {test_support::bin_path("auv_sim"), "--vehicle", vehicle, "--vehicles", "2"});
+    print(placement, 1, 0, steps, run_client(0, steps));
+
+    // Two client processes at once, each on its own vehicle; each prints its own line.
+    std::vector<pid_t> children;
+    for (int id = 0; id < 2; ++id) {
+      const pid_t pid = fork();
+      if (pid == 0) {
+        print(placement, 2, id, steps, run_client(id, steps));
+        _exit(0);
+      }
+      children.push_back(pid);
+    }
+    for (pid_t pid : children) waitpid(pid, nullptr, 0);
   }
-  for (pid_t pid : children) waitpid(pid, nullptr, 0);
+  sched_setaffinity(0, sizeof all, &all);
   return 0;
 }

@@ -1,0 +1,406 @@
+#include "agent/evaluation.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+
+#include "agent/pid_controller.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+
+namespace auvrl::agent {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Offsets of the fixed parts of the two layouts (see common/task/task.hpp).
+constexpr int kPaperFixedInputs = 12;
+constexpr int kExtendedFixedInputs = 17;
+
+const Scenario kAllScenarios[] = {Scenario::kTest1, Scenario::kTest2, Scenario::kFault,
+                                  Scenario::kCurrent, Scenario::kSuite};
+
+/// An ofstream that throws with the path on failure.
+std::ofstream open_for_writing(const std::string& path) {
+  std::ofstream out(path, std::ios::trunc);
+  if (!out) throw std::runtime_error(path + ": cannot open for writing");
+  out << std::setprecision(9);
+  return out;
+}
+
+/// -0 written as 0 (a zero pitch of a level vehicle comes out of the kinematics as -0).
+double tidy(double v) { return v == 0.0 ? 0.0 : v; }
+
+void finish(std::ofstream& out, const std::string& path) {
+  out.flush();
+  if (!out) throw std::runtime_error(path + ": write failed");
+}
+
+}  // namespace
+
+const char* to_string(Scenario scenario) {
+  switch (scenario) {
+    case Scenario::kTest1:
+      return "test1";
+    case Scenario::kTest2:
+      return "test2";
+    case Scenario::kFault:
+      return "fault";
+    case Scenario::kCurrent:
+      return "current";
+    case Scenario::kSuite:
+      return "suite";
+  }
+  return "?";
+}
+
+std::vector<Scenario> parse_scenarios(const std::string& name) {
+  if (name == "all") return {std::begin(kAllScenarios), std::end(kAllScenarios)};
+  for (Scenario s : kAllScenarios) {
+    if (name == to_string(s)) return {s};
+  }
+  throw std::invalid_argument("scenario '" + name +
+                              "': expected test1, test2, fault, current, suite or all");
+}
+
+const char* end_reason_name(task::EndReason reason) {
+  switch (reason) {
+    case task::EndReason::kNone:
+      return "none";
+    case task::EndReason::kReached:
+      return "reached";
+    case task::EndReason::kTimeLimit:
+      return "time_limit";
+    case task::EndReason::kLeftRegion:
+      return "left_region";
+    case task::EndReason::kFlipped:
+      return "flipped";
+    case task::EndReason::kBlowUp:
+      return "blow_up";
+    case task::EndReason::kSimTimeout:
+      return "sim_timeout";
+  }
+  return "?";
+}
+
+std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config,
+                                                 Scenario scenario) {
+  const task::TaskConfig& task = config.task;
+  EvaluationEpisode base;
+  base.scenario = scenario;
+  base.goal_ned_m = config.test_goal_ned_m;
+  base.start.position_ned_m = task.start_position_ned_m;
+  base.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
+  base.start.seed = config.seed;
+  const Eigen::Vector2d line = (base.goal_ned_m - base.start.position_ned_m).head<2>();
+  const double bearing_rad = std::atan2(line[1], line[0]);
+
+  switch (scenario) {
+    case Scenario::kTest1:
+      return {base};
+    case Scenario::kTest2: {
+      double yaw = bearing_rad + kPi;
+      if (yaw > kPi) yaw -= 2.0 * kPi;
+      base.start.euler_rpy_rad[2] = yaw;
+      return {base};
+    }
+    case Scenario::kFault:
+      if (config.fault_thruster < 0 || config.fault_thruster >= task.num_thrusters) {
+        throw std::invalid_argument("evaluation: fault thruster index " +
+                                    std::to_string(config.fault_thruster) + " is not one of the " +
+                                    std::to_string(task.num_thrusters) + " thrusters");
+      }
+      base.start.thruster_efficiency.assign(static_cast<std::size_t>(task.num_thrusters), 1.0);
+      base.start.thruster_efficiency[static_cast<std::size_t>(config.fault_thruster)] =
+          config.fault_efficiency;
+      return {base};
+    case Scenario::kCurrent: {
+      // Perpendicular to the horizontal start->goal line, to its right (bearing + 90 deg).
+      const double across = bearing_rad + kPi / 2.0;
+      base.start.current_ned_mps =
+          config.current_speed_mps * Eigen::Vector3d(std::cos(across), std::sin(across), 0.0);
+      return {base};
+    }
+    case Scenario::kSuite: {
+      if (config.suite_episodes < 0) {
+        throw std::invalid_argument("evaluation: suite_episodes must be >= 0");
+      }
+      std::mt19937_64 rng(config.seed);
+      std::vector<EvaluationEpisode> episodes;
+      for (int i = 0; i < config.suite_episodes; ++i) {
+        EvaluationEpisode e = base;
+        e.index = i;
+        e.goal_ned_m = task::sample_goal(task, rng);
+        e.start.seed = config.seed + static_cast<std::uint64_t>(i);
+        episodes.push_back(e);
+      }
+      return episodes;
+    }
+  }
+  return {};
+}
+
+SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
+                                  Controller& controller, const EvaluationEpisode& episode,
+                                  std::vector<TrajectoryRow>* trajectory) {
+  std::unique_ptr<VehicleLink> link = make_in_process_link(model);
+  if (trajectory) {
+    // The reset state as the first row (run_episode records from the first step on); the
+    // in-process link is deterministic, so run_episode's own reset gives the same state.
+    trajectory->clear();
+    const std::optional<VehicleReport> first = link->reset(episode.start);
+    if (first) {
+      const auto n = static_cast<std::size_t>(model.num_thrusters());
+      trajectory->push_back({first->time_s, first->observation, std::vector<double>(n, 0.0),
+                             first->thrust_realised_n,
+                             (episode.goal_ned_m - first->observation.position_ned_m).norm()});
+    }
+  }
+  EpisodeOptions options;
+  options.goal_ned_m = episode.goal_ned_m;
+  options.beta_m = config.reach_radius_m;
+  options.start = episode.start;
+  options.reach_radius_m = config.reach_radius_m;
+  options.run_full_time = true;
+  options.trajectory = trajectory;
+  const EpisodeSummary s = run_episode(config.task, *link, controller, options);
+
+  SummaryRow row;
+  row.scenario = to_string(episode.scenario);
+  row.controller = controller.name();
+  row.episode = episode.index;
+  row.goal_ned_m = episode.goal_ned_m;
+  row.reached = s.time_to_reach_s >= 0;
+  row.time_to_reach_s = s.time_to_reach_s;
+  row.mean_error_after_reach_m = row.reached ? s.mean_error_after_reach_m : -1.0;
+  row.final_error_m = s.final_distance_m;
+  row.thrust_energy = s.thrust_energy;
+  row.end_reason = s.end_reason;
+  return row;
+}
+
+std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, EvaluationConfig config,
+                                       Controller& controller,
+                                       const std::vector<Scenario>& scenarios,
+                                       const std::string& out_dir) {
+  config.task.num_thrusters = model.num_thrusters();
+  config.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
+  config.task.control_step_s = model.control_step_s;
+  config.task.validate();
+  if (!(config.reach_radius_m > 0)) {
+    throw std::invalid_argument("evaluation: reach radius must be > 0");
+  }
+  const std::filesystem::path dir(out_dir);
+  if (!out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(dir / "trajectories", ec);
+    if (ec) {
+      throw std::runtime_error((dir / "trajectories").string() +
+                               ": cannot create directory: " + ec.message());
+    }
+  }
+  std::vector<SummaryRow> rows;
+  std::vector<TrajectoryRow> trajectory;
+  for (Scenario scenario : scenarios) {
+    for (const EvaluationEpisode& episode : scenario_episodes(config, scenario)) {
+      const bool write_trajectory =
+          !out_dir.empty() && (scenario != Scenario::kSuite || config.suite_trajectories < 0 ||
+                               episode.index < config.suite_trajectories);
+      rows.push_back(run_evaluation_episode(model, config, controller, episode,
+                                            write_trajectory ? &trajectory : nullptr));
+      if (write_trajectory) {
+        const std::string name =
+            std::string(to_string(scenario)) + "_" + std::to_string(episode.index) + ".csv";
+        write_trajectory_csv((dir / "trajectories" / name).string(), trajectory,
+                             model.num_thrusters());
+      }
+    }
+  }
+  if (!out_dir.empty()) write_summary_csv((dir / "summary.csv").string(), rows);
+  return rows;
+}
+
+std::string summary_csv_header() {
+  return "scenario,controller,episode,goal_x,goal_y,goal_z,reached,time_to_reach_s,"
+         "mean_error_after_reach_m,final_error_m,thrust_energy,end_reason";
+}
+
+void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& rows) {
+  std::ofstream out = open_for_writing(path);
+  out << summary_csv_header() << '\n';
+  for (const SummaryRow& r : rows) {
+    out << r.scenario << ',' << r.controller << ',' << r.episode << ',' << r.goal_ned_m[0] << ','
+        << r.goal_ned_m[1] << ',' << r.goal_ned_m[2] << ',' << (r.reached ? 1 : 0) << ',';
+    if (r.reached) {
+      out << r.time_to_reach_s << ',' << r.mean_error_after_reach_m;
+    } else {
+      out << ',';  // never reached: both cells empty
+    }
+    out << ',' << r.final_error_m << ',' << r.thrust_energy << ',' << end_reason_name(r.end_reason)
+        << '\n';
+  }
+  finish(out, path);
+}
+
+std::string trajectory_csv_header(int num_thrusters) {
+  std::string h = "t,x,y,z,phi,theta,psi,u,v,w,p,q,r";
+  for (int i = 1; i <= num_thrusters; ++i) h += ",cmd_" + std::to_string(i);
+  for (int i = 1; i <= num_thrusters; ++i) h += ",thrust_" + std::to_string(i);
+  return h + ",distance_m";
+}
+
+void write_trajectory_csv(const std::string& path, const std::vector<TrajectoryRow>& rows,
+                          int num_thrusters) {
+  std::ofstream out = open_for_writing(path);
+  out << trajectory_csv_header(num_thrusters) << '\n';
+  const auto n = static_cast<std::size_t>(num_thrusters);
+  for (const TrajectoryRow& r : rows) {
+    if (r.thrust_command_n.size() != n || r.thrust_realised_n.size() != n) {
+      throw std::invalid_argument(path + ": a trajectory row does not have " +
+                                  std::to_string(num_thrusters) + " thrusters");
+    }
+    const task::Observation& o = r.observation;
+    out << tidy(r.time_s);
+    for (const Eigen::Vector3d* v :
+         {&o.position_ned_m, &o.euler_rpy_rad, &o.velocity_body_mps, &o.angular_rate_body_rad_s}) {
+      out << ',' << tidy((*v)[0]) << ',' << tidy((*v)[1]) << ',' << tidy((*v)[2]);
+    }
+    for (double f : r.thrust_command_n) out << ',' << tidy(f);
+    for (double f : r.thrust_realised_n) out << ',' << tidy(f);
+    out << ',' << r.distance_m << '\n';
+  }
+  finish(out, path);
+}
+
+std::string format_summary_table(const std::vector<SummaryRow>& rows) {
+  struct Totals {
+    int episodes = 0, reached = 0;
+    double time = 0, hold = 0, final_error = 0, energy = 0;
+    std::string controller;
+  };
+  std::vector<std::string> order;
+  std::map<std::string, Totals> by_scenario;
+  for (const SummaryRow& r : rows) {
+    if (!by_scenario.count(r.scenario)) order.push_back(r.scenario);
+    Totals& t = by_scenario[r.scenario];
+    t.controller = r.controller;
+    ++t.episodes;
+    if (r.reached) {
+      ++t.reached;
+      t.time += r.time_to_reach_s;
+      t.hold += r.mean_error_after_reach_m;
+    }
+    t.final_error += r.final_error_m;
+    t.energy += r.thrust_energy;
+  }
+  std::ostringstream out;
+  out << std::fixed;
+  out << std::left << std::setw(9) << "scenario" << std::setw(12) << "controller" << std::right
+      << std::setw(10) << "reached" << std::setw(13) << "time [s]" << std::setw(14)
+      << "hold err [m]" << std::setw(15) << "final err [m]" << std::setw(10) << "energy" << '\n';
+  for (const std::string& name : order) {
+    const Totals& t = by_scenario[name];
+    std::ostringstream reached;
+    reached << t.reached << "/" << t.episodes;
+    out << std::left << std::setw(9) << name << std::setw(12) << t.controller << std::right
+        << std::setw(10) << reached.str();
+    if (t.reached > 0) {
+      out << std::setw(13) << std::setprecision(1) << t.time / t.reached << std::setw(14)
+          << std::setprecision(2) << t.hold / t.reached;
+    } else {
+      out << std::setw(13) << "-" << std::setw(14) << "-";
+    }
+    out << std::setw(15) << std::setprecision(2) << t.final_error / t.episodes << std::setw(10)
+        << std::setprecision(1) << t.energy / t.episodes << '\n';
+  }
+  out << "time and hold error: means over the reached episodes (reached = within 0.5 m);\n"
+         "final error and energy: means over all episodes; energy = sum over 0.1 s steps of "
+         "the\nmean squared normalised thruster command.\n";
+  return out.str();
+}
+
+task::StateLayout infer_layout(int input_dim, int num_thrusters) {
+  if (input_dim == kPaperFixedInputs + num_thrusters) return task::StateLayout::kPaper;
+  if (input_dim == kExtendedFixedInputs + num_thrusters) return task::StateLayout::kExtended;
+  throw std::invalid_argument("a policy with " + std::to_string(input_dim) +
+                              " inputs fits no state layout for " + std::to_string(num_thrusters) +
+                              " thrusters: expected " +
+                              std::to_string(kPaperFixedInputs + num_thrusters) + " (paper) or " +
+                              std::to_string(kExtendedFixedInputs + num_thrusters) + " (extended)");
+}
+
+std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,
+                                                 const sim::VehicleModel& model,
+                                                 EvaluationConfig& config) {
+  const int n = model.num_thrusters();
+  config.task.num_thrusters = n;
+  if (!request.layout.empty()) config.task.layout = task::parse_layout(request.layout);
+  if (request.controller == "pid") {
+    if (!request.policy_path.empty()) {
+      throw std::invalid_argument("--policy and --controller pid exclude each other");
+    }
+    return std::make_unique<PidController>(model);
+  }
+  if (request.controller != "policy") {
+    throw std::invalid_argument("--controller '" + request.controller +
+                                "': expected policy (with --policy FILE) or pid");
+  }
+  if (request.policy_path.empty()) {
+    throw std::invalid_argument("--policy FILE is required (or --controller pid)");
+  }
+  nn::Mlp network = [&] {
+    std::vector<std::uint8_t> bytes;
+    try {
+      bytes = nn::read_file(request.policy_path);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("policy file (--policy): ") + e.what());
+    }
+    try {
+      return nn::network_from_bytes(bytes, 1);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("policy file " + request.policy_path +
+                               ": not a usable network file: " + e.what());
+    }
+  }();
+  const std::string where = "policy file " + request.policy_path + " (vehicle " + model.name + ")";
+  if (request.layout.empty()) {
+    try {
+      config.task.layout = infer_layout(network.spec().input_dim, n);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(where + ": " + e.what());
+    }
+  }
+  try {
+    return std::make_unique<PolicyController>(std::move(network), config.task.state_dim(), n);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + " with the " + task::to_string(config.task.layout) +
+                             " layout: " + e.what());
+  }
+}
+
+std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostream& out) {
+  if (request.out_dir.empty()) throw std::invalid_argument("--out DIR is required");
+  if (request.vehicle_path.empty()) throw std::invalid_argument("--vehicle FILE is required");
+  if (request.suite_episodes < 0) throw std::invalid_argument("--suite-episodes must be >= 0");
+  const std::vector<Scenario> scenarios = parse_scenarios(request.scenario);
+  const sim::VehicleModel model = sim::load_vehicle_file(request.vehicle_path);
+  EvaluationConfig config;
+  config.seed = request.seed;
+  config.suite_episodes = request.suite_episodes;
+  config.suite_trajectories = request.suite_trajectories;
+  std::unique_ptr<Controller> controller = make_eval_controller(request, model, config);
+  const std::vector<SummaryRow> rows =
+      run_evaluation(model, config, *controller, scenarios, request.out_dir);
+  out << format_summary_table(rows);
+  out << "wrote " << (std::filesystem::path(request.out_dir) / "summary.csv").string()
+      << " and trajectories/\n";
+  return rows;
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,148 @@
+// DDPG as in the paper's Algorithm 1 (Lillicrap et al. 2016), with TD3 (Fujimoto et al. 2018)
+// as an option of the same class.
+#pragma once
+
+#include <cstdint>
+#include <istream>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "common/nn/adam.hpp"
+#include "common/nn/mlp.hpp"
+#include "common/nn/random.hpp"
+#include "learner/replay_buffer.hpp"
+
+namespace auvrl::learner {
+
+/// Which update rule.
+enum class Algo : std::uint8_t {
+  kDdpg = 0,  ///< one critic, actor and targets updated every step (the paper)
+  kTd3 = 1,   ///< twin critics, target policy smoothing, delayed actor and target updates
+};
+
+/// "ddpg" or "td3".
+const char* to_string(Algo a);
+/// Parses "ddpg" or "td3"; throws std::invalid_argument otherwise.
+Algo parse_algo(const std::string& name);
+
+/// Every hyper-parameter of the update, named once, with its paper default: Lillicrap et al.
+/// (2016, section 7) for DDPG, as Algorithm 1 uses them; Fujimoto et al. (2018) for the TD3
+/// additions, which only act when algo == kTd3. state_dim and action_dim have no default: they
+/// are the task's.
+struct DdpgConfig {
+  Algo algo = Algo::kDdpg;
+  int state_dim = 0;
+  int action_dim = 0;
+
+  std::vector<int> actor_hidden{400, 300};   ///< hidden units of mu
+  std::vector<int> critic_hidden{400, 300};  ///< hidden units of Q
+  /// Weight layer of Q that receives the action: 1 = concatenated to the first hidden layer's
+  /// output ("actions were not included until the 2nd hidden layer of Q"); 0 = with the state.
+  int critic_action_layer = 1;
+
+  float actor_lr = 1e-4f;   ///< Adam learning rate of mu
+  float critic_lr = 1e-3f;  ///< Adam learning rate of Q
+  /// L2 weight decay of Q, on its weights (every layer), not its biases (see nn::AdamConfig).
+  float critic_weight_decay = 1e-2f;
+  float actor_weight_decay = 0.0f;
+  float actor_grad_clip_norm = 0.0f;   ///< global-norm clipping of mu's gradient; 0: off
+  float critic_grad_clip_norm = 0.0f;  ///< global-norm clipping of Q's gradient; 0: off
+
+  float gamma = 0.99f;  ///< discount
+  float tau = 1e-3f;    ///< soft target update rate (Eq. 7)
+  int batch_size = 64;  ///< minibatch size m (also the largest batch the networks accept)
+  /// Capacity of R. Not used by this class (the caller owns the ReplayBuffer) but named here so
+  /// that the whole preset lives in one place.
+  std::size_t replay_capacity = 1000000;
+
+  float td3_target_noise = 0.2f;       ///< std of the target policy smoothing noise
+  float td3_target_noise_clip = 0.5f;  ///< the noise is clipped to +-this
+  int td3_policy_delay = 2;            ///< critic updates per actor and target update
+
+  std::uint64_t seed = 1;  ///< initial weights, minibatch sampling and TD3 noise
+
+  /// Throws std::invalid_argument naming the first unusable value.
+  void validate() const;
+};
+
+/// What one update reports.
+struct UpdateStats {
+  float critic_loss = 0;  ///< mean squared TD error before the step (TD3: sum over both critics)
+  float actor_loss = 0;   ///< -mean Q(x, mu(x)) of the actor step (last one if none this update)
+  float mean_q = 0;       ///< mean Q(x, u) over the minibatch (first critic), before the step
+  bool actor_updated = false;  ///< false on TD3's delayed steps
+  float critic_grad_norm = 0;  ///< global norm of the (first) critic's loss gradient
+  float actor_grad_norm = 0;   ///< global norm of the actor's loss gradient (if updated)
+};
+
+/// The learner's networks, optimisers and update rule. Construction is Algorithm 1's lines 1-2
+/// (networks initialised from config.seed, targets copied from them); update() is lines 12-20.
+/// Nothing is allocated per update. Not thread-safe.
+class Ddpg {
+ public:
+  explicit Ddpg(const DdpgConfig& config);
+
+  /// Lines 12-20: samples a minibatch of config.batch_size from `replay` and learns from it.
+  UpdateStats update(const ReplayBuffer& replay);
+  /// Lines 13-20 on a given minibatch (1 <= batch.size <= config.batch_size).
+  UpdateStats update(const Batch& batch);
+
+  /// Deterministic policy mu(x) for a batch of states (state_dim x n, n <= batch_size); valid
+  /// until the next call or update.
+  Eigen::Block<const nn::Matrix> act(const nn::ConstMatrixRef& states);
+
+  const DdpgConfig& config() const { return config_; }
+  const nn::Mlp& actor() const { return actor_; }
+  const nn::Mlp& actor_target() const { return actor_target_; }
+  /// Critic i (0, or 0 and 1 for TD3) and its target.
+  const nn::Mlp& critic(int i = 0) const { return critics_[static_cast<std::size_t>(i)]; }
+  const nn::Mlp& critic_target(int i = 0) const {
+    return critic_targets_[static_cast<std::size_t>(i)];
+  }
+  int num_critics() const { return static_cast<int>(critics_.size()); }
+  /// Updates done (critic steps).
+  std::int64_t updates() const { return updates_; }
+  /// Actor steps done (fewer than updates() with TD3's delay).
+  std::int64_t actor_updates() const { return actor_updates_; }
+
+  /// Writes the full learning state (networks, targets, Adam moments, step counters, random
+  /// generator) as one self-checking record:
+  ///   char[8] "AUVRLDG\0", u32 version (1), u8 algo, u32 state_dim, u32 action_dim,
+  ///   u32 number of critics, u64 updates, u64 actor updates, f32 last actor loss,
+  ///   then each network as u64 length + its nn format (actor, actor target, then each critic
+  ///   and its target), the Adam states (actor, then each critic), the generator state, and
+  ///   the CRC-32 of all of it. The hyper-parameters are not in it: they come from the
+  ///   configuration.
+  void save(std::ostream& os) const;
+  void save(nn::Writer& w) const;
+  /// Restores a record written by save() from a learner of the same algorithm and network
+  /// architectures. Throws std::runtime_error saying what differs or what is damaged; the
+  /// learner is unchanged then. After restore, updates continue exactly as they would have.
+  void restore(std::istream& is);
+  void restore(nn::Reader& r);
+
+ private:
+  void actor_step(const nn::ConstMatrixRef& x, UpdateStats& stats);
+
+  DdpgConfig config_;
+  nn::Rng rng_;
+  nn::Mlp actor_;
+  nn::Mlp actor_target_;
+  std::vector<nn::Mlp> critics_;
+  std::vector<nn::Mlp> critic_targets_;
+  nn::Adam actor_opt_;
+  std::vector<nn::Adam> critic_opts_;
+  std::int64_t updates_ = 0;
+  std::int64_t actor_updates_ = 0;
+  float last_actor_loss_ = 0;
+  // Workspaces, sized for batch_size.
+  Batch batch_;
+  nn::Matrix next_action_;  // u'_{i+1} (action_dim x m)
+  nn::Matrix noise_;        // TD3 target smoothing noise (action_dim x m)
+  nn::Matrix target_q_;     // Q'(x_{i+1}, u'_{i+1}) (1 x m)
+  nn::Matrix y_;            // targets y_i (1 x m)
+  nn::Matrix dq_;           // dL/dQ (1 x m)
+};
+
+}  // namespace auvrl::learner

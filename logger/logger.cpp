@@ -1,0 +1,264 @@
+#include "logger/logger.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <stdexcept>
+
+#include "logger/decode.hpp"
+
+namespace auvrl::logger {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Clock::duration seconds(double s) {
+  return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+}
+
+std::string utc_text(std::int64_t utime) {
+  const std::time_t t = static_cast<std::time_t>(utime / 1000000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[40];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
+}
+
+}  // namespace
+
+ThrottleRule parse_throttle_rule(const std::string& text) {
+  const auto eq = text.rfind('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size()) {
+    throw std::invalid_argument("throttle '" + text +
+                                "': expected REGEX=SECONDS, e.g. POLICY_WEIGHTS=10");
+  }
+  ThrottleRule rule;
+  rule.pattern = text.substr(0, eq);
+  const std::string seconds_text = text.substr(eq + 1);
+  char* end = nullptr;
+  rule.interval_s = std::strtod(seconds_text.c_str(), &end);
+  if (*end != '\0' || !std::isfinite(rule.interval_s) || rule.interval_s < 0.0) {
+    throw std::invalid_argument("throttle '" + text + "': interval '" + seconds_text +
+                                "' is not a number of seconds >= 0");
+  }
+  try {
+    std::regex check(rule.pattern);
+  } catch (const std::regex_error& e) {
+    throw std::invalid_argument("throttle '" + text + "': '" + rule.pattern +
+                                "' is not a valid regex (" + e.what() + ")");
+  }
+  return rule;
+}
+
+Logger::Logger(transport::Transport& transport, LoggerConfig config)
+    : transport_(transport),
+      config_(std::move(config)),
+      writer_(config_.dir, config_.prefix,
+              static_cast<std::uint64_t>(std::max(1.0, config_.max_file_mb * 1e6))) {
+  if (!(config_.max_file_mb > 0.0) || !(config_.flush_period_s > 0.0) ||
+      !(config_.heartbeat_period_s > 0.0)) {
+    throw std::invalid_argument("max file size, flush period and heartbeat period must be > 0");
+  }
+  std::vector<ThrottleRule> rules = config_.throttles;
+  rules.push_back(kDefaultPolicyThrottle);
+  for (const ThrottleRule& rule : rules) {
+    try {
+      throttles_.emplace_back(std::regex(rule.pattern), rule.interval_s);
+    } catch (const std::regex_error& e) {
+      throw std::invalid_argument("throttle regex '" + rule.pattern + "' is invalid: " + e.what());
+    }
+  }
+  start_utime_ = transport::now_utime();
+  start_ = Clock::now();
+  next_flush_ = start_ + seconds(config_.flush_period_s);
+  next_heartbeat_ = start_;
+  subscription_ = transport_.subscribe(
+      config_.channels, [this](const transport::RawMessage& raw) { on_message(raw); },
+      config_.queue_capacity);
+}
+
+Logger::~Logger() {
+  if (subscription_ >= 0) transport_.unsubscribe(subscription_);
+}
+
+double Logger::throttle_interval(const std::string& channel) const {
+  for (const auto& [regex, interval] : throttles_) {
+    if (std::regex_match(channel, regex)) return interval;
+  }
+  return 0.0;
+}
+
+ChannelCounts& Logger::channel(const std::string& name) {
+  const auto it = channel_index_.find(name);
+  if (it != channel_index_.end()) return channels_[it->second];
+  channel_index_.emplace(name, channels_.size());
+  ChannelCounts counts;
+  counts.channel = name;
+  counts.throttle_interval_s = throttle_interval(name);  // regexes run once per channel
+  channels_.push_back(std::move(counts));
+  return channels_.back();
+}
+
+void Logger::on_message(const transport::RawMessage& raw) {
+  ChannelCounts& counts = channel(raw.channel);
+  ++counts.received;
+  ++received_;
+  std::uint64_t fingerprint = 0;
+  if (read_fingerprint(raw.data, raw.size, fingerprint) && counts.fingerprints.size() < 4 &&
+      std::find(counts.fingerprints.begin(), counts.fingerprints.end(), fingerprint) ==
+          counts.fingerprints.end()) {
+    counts.fingerprints.push_back(fingerprint);
+  }
+  if (counts.throttle_interval_s > 0.0 && counts.written > 0 &&
+      static_cast<double>(raw.recv_utime - counts.last_written_utime) <
+          counts.throttle_interval_s * 1e6) {
+    ++counts.throttled;
+    ++throttled_;
+    return;
+  }
+  try {
+    writer_.write(raw.channel, raw.data, raw.size, raw.recv_utime);
+  } catch (const LogError& e) {
+    ++counts.write_errors;
+    ++write_errors_;
+    // One line per error would flood a full disk's worth of messages into stderr.
+    if (write_errors_ == 1 || write_errors_ % 1000 == 0) {
+      std::cerr << "auv_logger: " << e.what() << " (" << write_errors_ << " write errors)\n";
+    }
+    return;
+  }
+  ++counts.written;
+  ++written_;
+  counts.bytes_written += RotatingLogWriter::event_bytes(raw.channel.size(), raw.size);
+  counts.last_written_utime = raw.recv_utime;
+  unflushed_ = true;
+}
+
+void Logger::flush() {
+  if (!unflushed_) return;
+  try {
+    writer_.flush();
+  } catch (const LogError& e) {
+    std::cerr << "auv_logger: " << e.what() << "\n";
+  }
+  unflushed_ = false;
+}
+
+void Logger::poll(int timeout_ms) {
+  // A bounded batch: under a flood, the flush and the heartbeat below still run on time.
+  constexpr int kBatch = 2000;
+  if (transport_.handle_one(timeout_ms)) {
+    for (int i = 1; i < kBatch && transport_.handle_one(0); ++i) {
+    }
+  }
+  const auto now = Clock::now();
+  if (now >= next_flush_) {
+    flush();
+    next_flush_ = now + seconds(config_.flush_period_s);
+  }
+  if (now >= next_heartbeat_) {
+    publish_heartbeat();
+    next_heartbeat_ = now + seconds(config_.heartbeat_period_s);
+  }
+}
+
+int Logger::drain(int max_ms) {
+  const auto deadline = Clock::now() + std::chrono::milliseconds(max_ms);
+  int count = 0;
+  while (Clock::now() < deadline && transport_.handle_one(0)) ++count;
+  return count;
+}
+
+auvrl_lcm::logger_heartbeat_t Logger::heartbeat() const {
+  auvrl_lcm::logger_heartbeat_t hb{};
+  hb.utime = transport::now_utime();
+  hb.pid = static_cast<std::int32_t>(getpid());
+  hb.log_dir = config_.dir;
+  hb.current_file = writer_.current_path();
+  hb.files_written = static_cast<std::int32_t>(writer_.files().size());
+  hb.bytes_written = static_cast<std::int64_t>(writer_.bytes_written());
+  hb.messages_received = received_;
+  hb.messages_written = written_;
+  hb.messages_throttled = throttled_;
+  hb.write_errors = write_errors_;
+  hb.uptime_s = std::chrono::duration<double>(Clock::now() - start_).count();
+  hb.num_channels = static_cast<std::int32_t>(channels_.size());
+  for (const ChannelCounts& c : channels_) {
+    hb.channel.push_back(c.channel);
+    hb.received.push_back(c.received);
+    hb.written.push_back(c.written);
+    hb.throttled.push_back(c.throttled);
+  }
+  return hb;
+}
+
+void Logger::publish_heartbeat() {
+  try {
+    transport::publish(transport_, channels::kLoggerHeartbeat, heartbeat());
+  } catch (const transport::TransportError& e) {
+    std::cerr << "auv_logger: heartbeat not sent: " << e.what() << "\n";
+  }
+}
+
+void Logger::write_summary(std::ostream& out, const Schema* schema) const {
+  const std::int64_t now = transport::now_utime();
+  out << "auv_logger summary\n";
+  out << "started   " << utc_text(start_utime_) << " (utime " << start_utime_ << ")\n";
+  out << "stopped   " << utc_text(now) << " (utime " << now << ")\n";
+  out << "directory " << config_.dir << "\n";
+  out << "files    ";
+  for (const std::string& file : writer_.files()) {
+    out << " " << file.substr(file.rfind('/') + 1);
+  }
+  out << "\nbytes_written " << writer_.bytes_written() << "\n";
+  out << "messages received " << received_ << " written " << written_ << " throttled " << throttled_
+      << " write_errors " << write_errors_ << "\n\n";
+  std::size_t width = 8;
+  for (const ChannelCounts& c : channels_) width = std::max(width, c.channel.size());
+  out << std::left << std::setw(static_cast<int>(width)) << "channel" << std::right << std::setw(12)
+      << "received" << std::setw(12) << "written" << std::setw(12) << "throttled" << std::setw(8)
+      << "errors" << std::setw(14) << "bytes"
+      << "  type\n";
+  for (const ChannelCounts& c : channels_) {
+    std::string types;
+    for (const std::uint64_t fp : c.fingerprints) {
+      if (!types.empty()) types += ", ";
+      types += schema != nullptr ? schema->names_for(fp) : fingerprint_hex(fp);
+    }
+    out << std::left << std::setw(static_cast<int>(width)) << c.channel << std::right
+        << std::setw(12) << c.received << std::setw(12) << c.written << std::setw(12) << c.throttled
+        << std::setw(8) << c.write_errors << std::setw(14) << c.bytes_written << "  " << types
+        << "\n";
+  }
+}
+
+std::string Logger::finish(const Schema* schema) {
+  if (finished_) return "";
+  finished_ = true;
+  drain(2000);
+  flush();
+  writer_.close();
+  publish_heartbeat();
+  if (subscription_ >= 0) {
+    transport_.unsubscribe(subscription_);
+    subscription_ = -1;
+  }
+  char name[64];
+  std::snprintf(name, sizeof name, "-%04d-summary.txt", writer_.first_file_number());
+  const std::string path = config_.dir + "/" + config_.prefix + name;
+  std::ofstream out(path);
+  write_summary(out, schema);
+  out.close();
+  if (!out) throw LogError("cannot write the summary " + path);
+  return path;
+}
+
+}  // namespace auvrl::logger

@@ -1,0 +1,357 @@
+// The evaluation: scenario definitions, summary.csv and trajectory files with their columns,
+// the text table, layout inference and the policy-file errors of `auvrl eval`.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "agent/evaluation.hpp"
+#include "agent/pid_controller.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+
+namespace auvrl::agent {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string vehicle_path() { return std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml"; }
+
+const sim::VehicleModel& nessie() {
+  static const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path());
+  return model;
+}
+
+/// A scratch directory for one test, removed at the end.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("auvrl_eval_test_" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  std::string path(const std::string& name = "") const { return (path_ / name).string(); }
+
+ private:
+  std::filesystem::path path_;
+};
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+std::vector<std::vector<std::string>> read_csv(const std::string& path) {
+  std::ifstream in(path);
+  EXPECT_TRUE(in.good()) << path;
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(in, line)) rows.push_back(split(line));
+  return rows;
+}
+
+EvaluationConfig six_thruster_config() {
+  EvaluationConfig c;
+  c.task.num_thrusters = 6;
+  return c;
+}
+
+TEST(Scenarios, ParsesNamesAndAll) {
+  const std::vector<Scenario> all = parse_scenarios("all");
+  ASSERT_EQ(all.size(), 5u);
+  EXPECT_EQ(all[0], Scenario::kTest1);
+  EXPECT_EQ(all[4], Scenario::kSuite);
+  for (Scenario s : all) EXPECT_EQ(parse_scenarios(to_string(s)), std::vector<Scenario>{s});
+  EXPECT_THROW(parse_scenarios("test3"), std::invalid_argument);
+}
+
+TEST(Scenarios, PaperTestsAsSpecified) {
+  const EvaluationConfig c = six_thruster_config();
+  const EvaluationEpisode t1 = scenario_episodes(c, Scenario::kTest1).at(0);
+  EXPECT_EQ(t1.start.position_ned_m, Eigen::Vector3d(0, 0, 5));
+  EXPECT_EQ(t1.start.euler_rpy_rad, Eigen::Vector3d::Zero());
+  EXPECT_EQ(t1.goal_ned_m, Eigen::Vector3d(7, 6, 10));
+  EXPECT_TRUE(t1.start.thruster_efficiency.empty());
+  EXPECT_EQ(t1.start.current_ned_mps, Eigen::Vector3d::Zero());
+
+  // Test 2: facing straight away from the way-point.
+  const EvaluationEpisode t2 = scenario_episodes(c, Scenario::kTest2).at(0);
+  const double bearing = std::atan2(6.0, 7.0);
+  EXPECT_NEAR(std::cos(t2.start.euler_rpy_rad[2] - bearing), -1.0, 1e-12);
+  EXPECT_LE(std::abs(t2.start.euler_rpy_rad[2]), kPi);
+  EXPECT_EQ(t2.goal_ned_m, t1.goal_ned_m);
+
+  // Fault: T1 at 10 %, the others healthy.
+  const EvaluationEpisode f = scenario_episodes(c, Scenario::kFault).at(0);
+  ASSERT_EQ(f.start.thruster_efficiency.size(), 6u);
+  EXPECT_DOUBLE_EQ(f.start.thruster_efficiency[0], 0.1);
+  for (std::size_t i = 1; i < 6; ++i) EXPECT_DOUBLE_EQ(f.start.thruster_efficiency[i], 1.0);
+
+  // Current: 0.3 m/s, horizontal, perpendicular to the start->goal line.
+  const EvaluationEpisode cur = scenario_episodes(c, Scenario::kCurrent).at(0);
+  EXPECT_NEAR(cur.start.current_ned_mps.norm(), 0.3, 1e-12);
+  EXPECT_NEAR(cur.start.current_ned_mps.z(), 0.0, 1e-12);
+  EXPECT_NEAR(cur.start.current_ned_mps.head<2>().dot(Eigen::Vector2d(7, 6)), 0.0, 1e-12);
+}
+
+TEST(Scenarios, SuiteIsDeterministicPerSeedAndInsideTheRegion) {
+  EvaluationConfig c = six_thruster_config();
+  const std::vector<EvaluationEpisode> a = scenario_episodes(c, Scenario::kSuite);
+  const std::vector<EvaluationEpisode> b = scenario_episodes(c, Scenario::kSuite);
+  ASSERT_EQ(a.size(), 100u);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].goal_ned_m, b[i].goal_ned_m);
+    EXPECT_EQ(a[i].index, static_cast<int>(i));
+    EXPECT_EQ(a[i].start.position_ned_m, c.task.start_position_ned_m);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(a[i].goal_ned_m[k], c.task.goal_min_ned_m[k]);
+      EXPECT_LE(a[i].goal_ned_m[k], c.task.goal_max_ned_m[k]);
+    }
+  }
+  c.seed = 2;
+  EXPECT_NE(scenario_episodes(c, Scenario::kSuite)[0].goal_ned_m, a[0].goal_ned_m);
+  c.fault_thruster = 6;
+  EXPECT_THROW(scenario_episodes(c, Scenario::kFault), std::invalid_argument);
+}
+
+TEST(Evaluation, WritesSummaryAndTrajectoriesWithTheRightColumns) {
+  TempDir dir;
+  EvaluationConfig c;
+  c.suite_episodes = 3;
+  c.suite_trajectories = 2;
+  PidController pid(nessie());
+  const std::vector<SummaryRow> rows = run_evaluation(
+      nessie(), c, pid, {Scenario::kTest1, Scenario::kFault, Scenario::kSuite}, dir.path("out"));
+  ASSERT_EQ(rows.size(), 5u);
+
+  const auto summary = read_csv(dir.path("out/summary.csv"));
+  ASSERT_EQ(summary.size(), 6u);
+  const std::vector<std::string> header = {
+      "scenario",      "controller",      "episode",
+      "goal_x",        "goal_y",          "goal_z",
+      "reached",       "time_to_reach_s", "mean_error_after_reach_m",
+      "final_error_m", "thrust_energy",   "end_reason"};
+  EXPECT_EQ(summary[0], header);
+  EXPECT_EQ(summary[1][0], "test1");
+  EXPECT_EQ(summary[1][1], "pid");
+  EXPECT_EQ(summary[1][2], "0");
+  EXPECT_EQ(summary[1][3], "7");
+  EXPECT_EQ(summary[1][4], "6");
+  EXPECT_EQ(summary[1][5], "10");
+  EXPECT_EQ(summary[1][6], "1");
+  EXPECT_NEAR(std::stod(summary[1][7]), rows[0].time_to_reach_s, 1e-6);
+  EXPECT_EQ(summary[2][0], "fault");
+  EXPECT_EQ(summary[5][0], "suite");
+  EXPECT_EQ(summary[5][2], "2");
+  for (std::size_t i = 1; i < summary.size(); ++i) EXPECT_EQ(summary[i].size(), header.size());
+
+  // Trajectories: every paper test, the first two of the suite.
+  namespace fs = std::filesystem;
+  EXPECT_TRUE(fs::exists(dir.path("out/trajectories/test1_0.csv")));
+  EXPECT_TRUE(fs::exists(dir.path("out/trajectories/fault_0.csv")));
+  EXPECT_TRUE(fs::exists(dir.path("out/trajectories/suite_0.csv")));
+  EXPECT_TRUE(fs::exists(dir.path("out/trajectories/suite_1.csv")));
+  EXPECT_FALSE(fs::exists(dir.path("out/trajectories/suite_2.csv")));
+
+  const auto traj = read_csv(dir.path("out/trajectories/fault_0.csv"));
+  std::vector<std::string> columns = {"t", "x", "y", "z", "phi", "theta", "psi",
+                                      "u", "v", "w", "p", "q",   "r"};
+  for (int i = 1; i <= 6; ++i) columns.push_back("cmd_" + std::to_string(i));
+  for (int i = 1; i <= 6; ++i) columns.push_back("thrust_" + std::to_string(i));
+  columns.push_back("distance_m");
+  EXPECT_EQ(traj[0], columns);
+  ASSERT_EQ(traj.size(), 1u + 701u);  // the reset state, then 700 steps of 0.1 s
+  EXPECT_EQ(traj[1][0], "0");
+  EXPECT_EQ(traj[1][3], "5");
+  EXPECT_NEAR(std::stod(traj.back()[0]), 70.0, 1e-9);
+  // The faulted T1 never realises more than 10 % of the maximum thrust, though it is asked to.
+  double max_cmd_1 = 0, max_thrust_1 = 0;
+  for (std::size_t i = 1; i < traj.size(); ++i) {
+    ASSERT_EQ(traj[i].size(), columns.size());
+    max_cmd_1 = std::max(max_cmd_1, std::abs(std::stod(traj[i][13])));
+    max_thrust_1 = std::max(max_thrust_1, std::abs(std::stod(traj[i][19])));
+  }
+  EXPECT_GT(max_cmd_1, 0.5 * 39.24);
+  EXPECT_LE(max_thrust_1, 0.1 * 39.24 + 1e-6);
+  // distance_m agrees with the position.
+  const auto& last = traj.back();
+  const double d =
+      std::hypot(7 - std::stod(last[1]), 6 - std::stod(last[2]), 10 - std::stod(last[3]));
+  EXPECT_NEAR(std::stod(last.back()), d, 1e-6);
+}
+
+TEST(Evaluation, NeverReachedLeavesTheReachCellsEmpty) {
+  TempDir dir;
+  SummaryRow row;
+  row.scenario = "test1";
+  row.controller = "policy";
+  row.goal_ned_m = Eigen::Vector3d(7, 6, 10);
+  row.final_error_m = 9.5;
+  row.thrust_energy = 12.0;
+  row.end_reason = task::EndReason::kTimeLimit;
+  write_summary_csv(dir.path("s.csv"), {row});
+  const auto csv = read_csv(dir.path("s.csv"));
+  ASSERT_EQ(csv.size(), 2u);
+  ASSERT_EQ(csv[1].size(), 12u);
+  EXPECT_EQ(csv[1][6], "0");
+  EXPECT_EQ(csv[1][7], "");
+  EXPECT_EQ(csv[1][8], "");
+  EXPECT_EQ(csv[1][9], "9.5");
+  EXPECT_EQ(csv[1][11], "time_limit");
+  // An unwritable path is an error naming it.
+  try {
+    write_summary_csv(dir.path("missing/dir/s.csv"), {row});
+    FAIL() << "expected std::runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing/dir/s.csv"), std::string::npos);
+  }
+}
+
+TEST(Evaluation, SummaryTableHasOneLinePerScenario) {
+  PidController pid(nessie());
+  EvaluationConfig c;
+  c.suite_episodes = 2;
+  const std::vector<SummaryRow> rows =
+      run_evaluation(nessie(), c, pid, {Scenario::kTest1, Scenario::kSuite}, "");
+  const std::string table = format_summary_table(rows);
+  EXPECT_NE(table.find("test1    pid                1/1"), std::string::npos) << table;
+  EXPECT_NE(table.find("suite    pid                2/2"), std::string::npos) << table;
+}
+
+TEST(Evaluation, InfersTheLayoutFromThePolicyInputs) {
+  EXPECT_EQ(infer_layout(18, 6), task::StateLayout::kPaper);
+  EXPECT_EQ(infer_layout(23, 6), task::StateLayout::kExtended);
+  EXPECT_EQ(infer_layout(20, 8), task::StateLayout::kPaper);
+  EXPECT_THROW(infer_layout(19, 6), std::invalid_argument);
+}
+
+nn::Mlp actor(int inputs) {
+  nn::Mlp net(nn::MlpSpec::actor(inputs, {16}, 6), 1);
+  nn::Rng rng(3);
+  net.init_lillicrap(rng);
+  return net;
+}
+
+/// make_eval_controller's error message for a request, or "" if it succeeded.
+std::string controller_error(const EvalRequest& request, EvaluationConfig& config) {
+  try {
+    make_eval_controller(request, nessie(), config);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(EvalCommand, PolicyFilesLoadWithTheirLayout) {
+  TempDir dir;
+  nn::save_network_file(dir.path("extended.net"), actor(23));
+  nn::save_network_file(dir.path("paper.net"), actor(18));
+  EvalRequest request;
+  request.controller = "policy";
+  request.policy_path = dir.path("extended.net");
+  EvaluationConfig config;
+  auto controller = make_eval_controller(request, nessie(), config);
+  EXPECT_EQ(controller->name(), "policy");
+  EXPECT_EQ(config.task.layout, task::StateLayout::kExtended);
+  request.policy_path = dir.path("paper.net");
+  controller = make_eval_controller(request, nessie(), config);
+  EXPECT_EQ(config.task.layout, task::StateLayout::kPaper);
+  // And it runs (an untrained policy need not reach anything).
+  const std::vector<SummaryRow> rows =
+      run_evaluation(nessie(), config, *controller, {Scenario::kTest1}, "");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].controller, "policy");
+}
+
+TEST(EvalCommand, ClearErrorsForBadPolicyFiles) {
+  TempDir dir;
+  EvaluationConfig config;
+  EvalRequest request;
+  request.controller = "policy";
+
+  request.policy_path = dir.path("nothing_here.net");
+  std::string error = controller_error(request, config);
+  EXPECT_NE(error.find("nothing_here.net"), std::string::npos) << error;
+
+  {
+    std::ofstream garbage(dir.path("garbage.net"));
+    garbage << "this is not a network";
+  }
+  request.policy_path = dir.path("garbage.net");
+  error = controller_error(request, config);
+  EXPECT_NE(error.find("garbage.net"), std::string::npos) << error;
+
+  // A network with a size that fits no layout.
+  nn::save_network_file(dir.path("odd.net"), actor(20));
+  request.policy_path = dir.path("odd.net");
+  error = controller_error(request, config);
+  EXPECT_NE(error.find("odd.net"), std::string::npos) << error;
+  EXPECT_NE(error.find("18 (paper) or 23 (extended)"), std::string::npos) << error;
+
+  // An explicit layout that the network does not fit.
+  nn::save_network_file(dir.path("extended.net"), actor(23));
+  request.policy_path = dir.path("extended.net");
+  request.layout = "paper";
+  error = controller_error(request, config);
+  EXPECT_NE(error.find("extended.net"), std::string::npos) << error;
+  EXPECT_NE(error.find("in=18"), std::string::npos) << error;
+
+  // A truncated file (checksum and size checks).
+  std::vector<std::uint8_t> bytes = nn::read_file(dir.path("extended.net"));
+  bytes.resize(bytes.size() / 2);
+  nn::write_file_atomically(dir.path("truncated.net"), bytes);
+  request.layout.clear();
+  request.policy_path = dir.path("truncated.net");
+  error = controller_error(request, config);
+  EXPECT_NE(error.find("truncated.net"), std::string::npos) << error;
+
+  // No policy at all, or both a policy and the PID, or an unknown controller.
+  request.policy_path.clear();
+  EXPECT_THROW(make_eval_controller(request, nessie(), config), std::invalid_argument);
+  request.controller = "pid";
+  request.policy_path = dir.path("extended.net");
+  EXPECT_THROW(make_eval_controller(request, nessie(), config), std::invalid_argument);
+  request.controller = "lqr";
+  EXPECT_THROW(make_eval_controller(request, nessie(), config), std::invalid_argument);
+}
+
+TEST(EvalCommand, RunsThePidEndToEnd) {
+  TempDir dir;
+  EvalRequest request;
+  request.controller = "pid";
+  request.scenario = "test2";
+  request.out_dir = dir.path("run");
+  request.vehicle_path = vehicle_path();
+  std::ostringstream out;
+  const std::vector<SummaryRow> rows = run_eval_request(request, out);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(rows[0].reached);
+  EXPECT_NE(out.str().find("test2"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir.path("run/summary.csv")));
+  EXPECT_TRUE(std::filesystem::exists(dir.path("run/trajectories/test2_0.csv")));
+  request.out_dir.clear();
+  EXPECT_THROW(run_eval_request(request, out), std::invalid_argument);
+  request.out_dir = dir.path("run");
+  request.vehicle_path = dir.path("no_vehicle.yaml");
+  EXPECT_THROW(run_eval_request(request, out), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace auvrl::agent

@@ -1,0 +1,37 @@
+// Prints the learner's update rates: the three standard cases (AUV dims 29/6, one thread), for
+// DDPG and TD3, and the same with pendulum dims (state 3, action 1), as RLtools reports them.
+// Usage: bench_updates [seconds per case]. Not a CTest test.
+#include <cstdlib>
+#include <iostream>
+
+#include "learner/bench.hpp"
+
+int main(int argc, char** argv) {
+  using namespace auvrl::learner;
+  const double seconds = argc > 1 ? std::atof(argv[1]) : 2.0;
+  for (Algo algo : {Algo::kDdpg, Algo::kTd3}) {
+    for (BenchCase c : standard_bench_cases(algo)) {
+      c.seconds = seconds;
+      print_bench_line(std::cout, run_update_benchmark(c));
+      c.state_dim = 3;
+      c.action_dim = 1;
+      print_bench_line(std::cout, run_update_benchmark(c));
+    }
+    // RLtools' published cases: batch 100 at 256-256 and 400-400.
+    for (auto hidden : {std::vector<int>{256, 256}, std::vector<int>{400, 400}}) {
+      for (int dims : {0, 1}) {
+        BenchCase c;
+        c.algo = algo;
+        c.hidden = hidden;
+        c.batch = 100;
+        c.seconds = seconds;
+        if (dims == 1) {
+          c.state_dim = 3;
+          c.action_dim = 1;
+        }
+        print_bench_line(std::cout, run_update_benchmark(c));
+      }
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,273 @@
+// The observation vectors: sizes, contents and scaling of both layouts, the goal error in the
+// body frame, hindsight relabelling, position recovery and way-point sampling.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include "common/task/task.hpp"
+
+namespace auvrl::task {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+TaskConfig config(StateLayout layout) {
+  TaskConfig c;
+  c.layout = layout;
+  return c;
+}
+
+StateVector build(const TaskConfig& c, const Observation& obs, const Eigen::Vector3d& goal,
+                  const ActionVector& previous) {
+  StateVector s;
+  build_state(c, obs, goal, previous, s);
+  return s;
+}
+
+/// Extended-layout body-frame goal error in metres.
+Eigen::Vector3d body_error_m(const TaskConfig& c, const StateVector& s) {
+  return s.head<3>().cast<double>() * c.scales.position_m;
+}
+
+TEST(StateLayout, Dimensions) {
+  EXPECT_EQ(config(StateLayout::kPaper).state_dim(), 18);
+  EXPECT_EQ(config(StateLayout::kExtended).state_dim(), 23);
+  TaskConfig c = config(StateLayout::kPaper);
+  c.num_thrusters = 8;
+  EXPECT_EQ(c.state_dim(), 20);
+  c.layout = StateLayout::kExtended;
+  EXPECT_EQ(c.state_dim(), 25);
+  const Observation obs;
+  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+    const TaskConfig t = config(layout);
+    EXPECT_EQ(build(t, obs, Eigen::Vector3d(1, 2, 3), ActionVector::Zero(6)).size(), t.state_dim());
+  }
+}
+
+TEST(StateLayout, WrongPreviousActionSizeIsRejected) {
+  StateVector s;
+  EXPECT_THROW(build_state(config(StateLayout::kPaper), Observation{}, Eigen::Vector3d::Zero(),
+                           ActionVector::Zero(5), s),
+               std::invalid_argument);
+}
+
+TEST(StateLayout, PaperContentsAndScaling) {
+  TaskConfig c = config(StateLayout::kPaper);
+  c.scales.position_m = 20.0;
+  c.scales.linear_velocity_mps = 2.0;
+  c.scales.angular_rate_rad_s = 0.5;
+  Observation obs;
+  obs.position_ned_m = Eigen::Vector3d(2.0, -4.0, 6.0);
+  obs.euler_rpy_rad = Eigen::Vector3d(0.1, 0.2, 1.0);  // the paper's layout has no attitude
+  obs.velocity_body_mps = Eigen::Vector3d(1.0, -0.5, 0.2);
+  obs.angular_rate_body_rad_s = Eigen::Vector3d(0.1, -0.2, 0.3);
+  ActionVector prev(6);
+  prev << 0.1f, -0.2f, 0.3f, -0.4f, 0.5f, -0.6f;
+  const StateVector s = build(c, obs, Eigen::Vector3d(7.0, 6.0, 10.0), prev);
+  const float expected[18] = {0.1f, -0.2f, 0.3f, 0.25f, 0.5f,  0.2f, 0.5f,  -0.25f, 0.1f,
+                              0.2f, -0.4f, 0.6f, 0.1f,  -0.2f, 0.3f, -0.4f, 0.5f,   -0.6f};
+  for (int i = 0; i < 18; ++i) EXPECT_NEAR(s[i], expected[i], 1e-6) << i;
+}
+
+TEST(StateLayout, ExtendedContentsAndScaling) {
+  TaskConfig c = config(StateLayout::kExtended);
+  c.scales.position_m = 5.0;
+  c.scales.linear_velocity_mps = 2.0;
+  c.scales.angular_rate_rad_s = 0.5;
+  c.scales.depth_m = 20.0;
+  Observation obs;
+  obs.position_ned_m = Eigen::Vector3d(1.0, 1.0, 8.0);
+  obs.euler_rpy_rad = Eigen::Vector3d(0.1, -0.2, 2.5);
+  obs.velocity_body_mps = Eigen::Vector3d(1.0, -0.5, 0.2);
+  obs.angular_rate_body_rad_s = Eigen::Vector3d(0.1, -0.2, 0.3);
+  ActionVector prev(6);
+  prev << 0.1f, -0.2f, 0.3f, -0.4f, 0.5f, -0.6f;
+  const Eigen::Vector3d goal(4.0, -3.0, 10.0);
+  const StateVector s = build(c, obs, goal, prev);
+  const Eigen::Vector3d e_body =
+      body_to_ned(obs.euler_rpy_rad).transpose() * (goal - obs.position_ned_m);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(s[i], e_body[i] / 5.0, 1e-6);
+  EXPECT_NEAR(s[3], (goal - obs.position_ned_m).norm() / 5.0, 1e-6);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(s[4 + 2 * i], std::sin(obs.euler_rpy_rad[i]), 1e-6);
+    EXPECT_NEAR(s[5 + 2 * i], std::cos(obs.euler_rpy_rad[i]), 1e-6);
+  }
+  EXPECT_NEAR(s[10], 0.5, 1e-6);
+  EXPECT_NEAR(s[11], -0.25, 1e-6);
+  EXPECT_NEAR(s[12], 0.1, 1e-6);
+  EXPECT_NEAR(s[13], 0.2, 1e-6);
+  EXPECT_NEAR(s[14], -0.4, 1e-6);
+  EXPECT_NEAR(s[15], 0.6, 1e-6);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(s[16 + i], prev[i]);
+  EXPECT_NEAR(s[22], 8.0 / 20.0, 1e-6);
+}
+
+TEST(StateLayout, GoalNorthOfAVehicleYawedToEastIsOnItsPortSide) {
+  const TaskConfig c = config(StateLayout::kExtended);
+  Observation obs;
+  obs.position_ned_m = Eigen::Vector3d(3.0, 4.0, 5.0);
+  obs.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, kPi / 2);  // facing east
+  const StateVector s =
+      build(c, obs, obs.position_ned_m + Eigen::Vector3d(6.0, 0.0, 0.0), ActionVector::Zero(6));
+  const Eigen::Vector3d e = body_error_m(c, s);
+  EXPECT_NEAR(e.x(), 0.0, 1e-5);
+  EXPECT_NEAR(e.y(), -6.0, 1e-5);  // port = body y negative
+  EXPECT_NEAR(e.z(), 0.0, 1e-5);
+  // Yawed to the west it is on the starboard side; yawed north it is straight ahead.
+  obs.euler_rpy_rad.z() = -kPi / 2;
+  EXPECT_NEAR(body_error_m(c, build(c, obs, obs.position_ned_m + Eigen::Vector3d(6, 0, 0),
+                                    ActionVector::Zero(6)))
+                  .y(),
+              6.0, 1e-5);
+  obs.euler_rpy_rad.z() = 0.0;
+  EXPECT_NEAR(body_error_m(c, build(c, obs, obs.position_ned_m + Eigen::Vector3d(6, 0, 0),
+                                    ActionVector::Zero(6)))
+                  .x(),
+              6.0, 1e-5);
+  // Facing away (test 2): the goal is straight behind.
+  obs.euler_rpy_rad.z() = kPi;
+  EXPECT_NEAR(body_error_m(c, build(c, obs, obs.position_ned_m + Eigen::Vector3d(6, 0, 0),
+                                    ActionVector::Zero(6)))
+                  .x(),
+              -6.0, 1e-5);
+}
+
+TEST(StateLayout, NoseUpPitchPutsAGoalAheadBelowTheBodyXAxis) {
+  const TaskConfig c = config(StateLayout::kExtended);
+  Observation obs;
+  obs.euler_rpy_rad = Eigen::Vector3d(0.0, kPi / 6, 0.0);  // 30 deg nose up, facing north
+  const StateVector s = build(c, obs, Eigen::Vector3d(10.0, 0.0, 0.0), ActionVector::Zero(6));
+  const Eigen::Vector3d e = body_error_m(c, s);
+  EXPECT_NEAR(e.x(), 10.0 * std::cos(kPi / 6), 1e-5);
+  EXPECT_NEAR(e.y(), 0.0, 1e-5);
+  EXPECT_NEAR(e.z(), 10.0 * std::sin(kPi / 6), 1e-5);  // body z down: below the nose
+}
+
+TEST(StateLayout, StarboardDownRollLeansDownTowardStarboard) {
+  const TaskConfig c = config(StateLayout::kExtended);
+  Observation obs;
+  obs.euler_rpy_rad = Eigen::Vector3d(kPi / 6, 0.0, 0.0);  // 30 deg roll, starboard down
+  const StateVector s = build(c, obs, Eigen::Vector3d(0.0, 0.0, 10.0), ActionVector::Zero(6));
+  const Eigen::Vector3d e = body_error_m(c, s);
+  EXPECT_NEAR(e.x(), 0.0, 1e-5);
+  EXPECT_NEAR(e.y(), 10.0 * std::sin(kPi / 6), 1e-5);
+  EXPECT_NEAR(e.z(), 10.0 * std::cos(kPi / 6), 1e-5);
+}
+
+TEST(StateLayout, BodyToNedIsARotation) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> angle(-1.5, 1.5);
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Matrix3d r = body_to_ned(Eigen::Vector3d(angle(rng), angle(rng), 2 * angle(rng)));
+    EXPECT_NEAR((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  }
+}
+
+/// Random observations: positions in the training region, any yaw, roll and pitch within
+/// +-1.2 rad (beyond that the episode has ended), velocities and a previous action.
+Observation random_observation(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> pos(-10.0, 10.0), tilt(-1.2, 1.2), yaw(-kPi, kPi),
+      vel(-1.5, 1.5);
+  Observation o;
+  o.position_ned_m = Eigen::Vector3d(pos(rng), pos(rng), 8.0 + 0.7 * pos(rng));
+  o.euler_rpy_rad = Eigen::Vector3d(tilt(rng), tilt(rng), yaw(rng));
+  o.velocity_body_mps = Eigen::Vector3d(vel(rng), vel(rng), vel(rng));
+  o.angular_rate_body_rad_s = Eigen::Vector3d(vel(rng), vel(rng), vel(rng));
+  return o;
+}
+
+TEST(Relabel, EqualsBuildingTheStateForTheNewGoal) {
+  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+    const TaskConfig c = config(layout);
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> goal(-10.0, 10.0);
+    std::uniform_real_distribution<float> act(-1.0f, 1.0f);
+    for (int i = 0; i < 500; ++i) {
+      const Observation obs = random_observation(rng);
+      const Eigen::Vector3d old_goal(goal(rng), goal(rng), 8.0 + 0.7 * goal(rng));
+      const Eigen::Vector3d new_goal(goal(rng), goal(rng), 8.0 + 0.7 * goal(rng));
+      ActionVector prev(6);
+      for (int k = 0; k < 6; ++k) prev[k] = act(rng);
+      StateVector relabelled = build(c, obs, old_goal, prev);
+      relabel_state(c, old_goal, new_goal, relabelled);
+      const StateVector direct = build(c, obs, new_goal, prev);
+      ASSERT_EQ(relabelled.size(), direct.size());
+      EXPECT_LT((relabelled - direct).cwiseAbs().maxCoeff(), 2e-6f)
+          << to_string(layout) << " sample " << i;
+    }
+  }
+}
+
+TEST(Relabel, ToTheSameGoalChangesNothing) {
+  const TaskConfig c = config(StateLayout::kExtended);
+  std::mt19937_64 rng(3);
+  const Observation obs = random_observation(rng);
+  const Eigen::Vector3d goal(1.0, 2.0, 3.0);
+  StateVector s = build(c, obs, goal, ActionVector::Zero(6));
+  const StateVector before = s;
+  relabel_state(c, goal, goal, s);
+  EXPECT_LT((s - before).cwiseAbs().maxCoeff(), 1e-6f);
+}
+
+TEST(PositionFromState, RecoversThePositionInBothLayouts) {
+  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+    const TaskConfig c = config(layout);
+    std::mt19937_64 rng(11);
+    for (int i = 0; i < 200; ++i) {
+      const Observation obs = random_observation(rng);
+      const Eigen::Vector3d goal(7.0, 6.0, 10.0);
+      const StateVector s = build(c, obs, goal, ActionVector::Zero(6));
+      EXPECT_LT((position_from_state(c, goal, s) - obs.position_ned_m).norm(), 1e-4)
+          << to_string(layout) << " sample " << i;
+    }
+  }
+}
+
+TEST(SampleGoal, InsideTheBoxAndCoveringIt) {
+  TaskConfig c;
+  c.goal_min_ned_m = Eigen::Vector3d(-10.0, -5.0, 1.0);
+  c.goal_max_ned_m = Eigen::Vector3d(10.0, 5.0, 15.0);
+  std::mt19937_64 rng(5);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo, sum = Eigen::Vector3d::Zero();
+  const int n = 5000;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d g = sample_goal(c, rng);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_GE(g[k], c.goal_min_ned_m[k]);
+      ASSERT_LE(g[k], c.goal_max_ned_m[k]);
+    }
+    lo = lo.cwiseMin(g);
+    hi = hi.cwiseMax(g);
+    sum += g;
+  }
+  // Uniform: it reaches near every face and its mean is the box centre.
+  const Eigen::Vector3d size = c.goal_max_ned_m - c.goal_min_ned_m;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LT(lo[k] - c.goal_min_ned_m[k], 0.01 * size[k]);
+    EXPECT_LT(c.goal_max_ned_m[k] - hi[k], 0.01 * size[k]);
+    EXPECT_NEAR(sum[k] / n, 0.5 * (c.goal_min_ned_m[k] + c.goal_max_ned_m[k]), 0.03 * size[k]);
+  }
+}
+
+TEST(SampleGoal, DeterministicPerSeed) {
+  const TaskConfig c;
+  std::mt19937_64 a(123), b(123), other(124);
+  bool any_difference = false;
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Vector3d ga = sample_goal(c, a);
+    EXPECT_EQ(ga, sample_goal(c, b));
+    any_difference |= ga != sample_goal(c, other);
+  }
+  EXPECT_TRUE(any_difference);
+  // A degenerate box gives its one point.
+  TaskConfig point;
+  point.goal_min_ned_m = point.goal_max_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);
+  EXPECT_EQ(sample_goal(point, a), Eigen::Vector3d(7.0, 6.0, 10.0));
+}
+
+}  // namespace
+}  // namespace auvrl::task
