@@ -42,7 +42,7 @@ void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::
     if (it == episodes_.end()) continue;
     const std::vector<std::int64_t>& slots = it->second;
     const std::size_t step = replay.step_index(slot);
-    if (step + 1 >= slots.size()) continue;
+    if (step >= slots.size()) continue;
     // A later step (this one included: its own achieved position is a valid future goal).
     const std::size_t future =
         step + static_cast<std::size_t>(nn::uniform_index(rng, slots.size() - step));
