@@ -5,6 +5,7 @@
 
 #include <iostream>
 
+#include "agent/actor_config.hpp"
 #include "agent/actor_node.hpp"
 #include "common/cli.hpp"
 #include "common/signals.hpp"
@@ -12,8 +13,21 @@
 int main(int argc, char** argv) {
   using namespace auvrl;
   agent::ActorNodeConfig config;
+  std::string config_path = cli::CommandLine::find_value(argc, argv, "config");
+  if (!config_path.empty()) {
+    try {
+      agent::read_actor_config_file(config_path, config);
+    } catch (const std::exception& e) {
+      std::cerr << "auv_actor: " << e.what() << "\n";
+      return 2;
+    }
+  }
   transport::TransportConfig transport_config;
-  std::string layout = "extended", reward = "paper", noise = "ou";
+  std::string layout = task::to_string(config.task.layout),
+              reward = task::to_string(config.task.reward),
+              noise = config.noise == agent::ExplorationNoise::Kind::kNone       ? "none"
+                      : config.noise == agent::ExplorationNoise::Kind::kGaussian ? "gaussian"
+                                                                                 : "ou";
   int vehicle_id = -1, pin_cpu = -1, report_every = 50;
   std::int64_t seed = 1;
   double start_z = config.task.start_position_ned_m.z();
@@ -21,6 +35,8 @@ int main(int argc, char** argv) {
   cli::CommandLine cmd("auv_actor",
                        "Exploration actor: runs episodes of the goal-driven task on its vehicle "
                        "of auv_sim with the newest policy plus noise; sends experience.");
+  cmd.option("config", &config_path,
+             "run configuration (YAML: task, schedule, actor); the options below override it");
   cmd.option("actor-id", &config.actor_id, "this actor's id (0..)");
   cmd.option("vehicle-id", &vehicle_id, "its vehicle in auv_sim (default: the actor id)");
   cmd.option("layout", &layout, "state layout: paper or extended");

@@ -5,7 +5,14 @@
 #include <iostream>
 #include <string>
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
+
 #include "agent/evaluation.hpp"
+#include "agent/launcher.hpp"
 #include "common/cli.hpp"
 
 namespace {
@@ -43,6 +50,72 @@ int run_eval(int argc, const char* const* argv) {
   return 0;
 }
 
+/// This executable's directory (where the other processes are built too).
+std::string own_bin_dir() {
+  std::error_code ec;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string(".") : exe.parent_path().string();
+}
+
+/// `auvrl train`: the whole training system, then evaluation, plots and report.
+int run_train(int argc, const char* const* argv) {
+  auvrl::agent::TrainOptions options;
+  options.source_dir = AUVRL_SOURCE_DIR;
+  options.bin_dir = own_bin_dir();
+  std::string preset = "fast", network = "private", resume_dir;
+  bool no_eval = false;
+  auvrl::cli::CommandLine cli(
+      "auvrl train",
+      "Trains a policy with the whole system (auv_sim per actor, N auv_actor, auv_learner,\n"
+      "auv_logger) in a private network namespace, shows progress, restarts crashed processes,\n"
+      "stops cleanly on Ctrl-C, then evaluates the policy and the PID baseline, draws the plots\n"
+      "and writes RUN/report.md.");
+  cli.option("preset", &preset, "config/presets/NAME.yaml (paper or fast)");
+  cli.option("config", &options.config_path, "a configuration file instead of a preset");
+  cli.option("run-dir", &options.run_dir, "run directory (default runs/<preset>-<time>)");
+  cli.option("resume", &resume_dir, "continue the stopped run in this directory");
+  cli.option("actors", &options.actors, "exploration actors (default: run.actors, 0 = one per CPU)");
+  cli.option("max-seconds", &options.max_train_s, "training budget, s (default: run.max_train_s)");
+  cli.option("seed", &options.seed, "seed of the run (default: run.seed)");
+  cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
+  cli.option("network", &network,
+             "private (default: own network namespace) or host (LCM on the host's network)");
+  if (!cli.parse(argc, argv)) return 0;
+  if (network != "private" && network != "host") {
+    throw auvrl::cli::UsageError("option --network: expected private or host");
+  }
+  options.evaluate = !no_eval;
+  if (!resume_dir.empty()) {
+    options.resume = true;
+    options.run_dir = resume_dir;
+  } else if (options.config_path.empty()) {
+    options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml";
+  }
+  const char* inside = std::getenv("AUVRL_IN_NETNS");
+  if (network == "host" || (inside != nullptr && std::string(inside) == "1")) {
+    if (inside == nullptr) auvrl::agent::prepare_run_directory(options);
+    return auvrl::agent::run_training(options, std::cout);
+  }
+  // Prepare the run directory here, then run again inside a private network namespace whose
+  // PID file the run directory keeps (lcm-spy and the log tools join it).
+  auvrl::agent::prepare_run_directory(options);
+  const std::string netns = std::string(AUVRL_SOURCE_DIR) + "/scripts/netns.sh";
+  std::vector<std::string> args = {netns, "--pidfile", options.run_dir + "/netns.pid",
+                                   own_bin_dir() + "/auvrl", "train", "--resume", options.run_dir};
+  if (options.actors >= 0) args.insert(args.end(), {"--actors", std::to_string(options.actors)});
+  if (options.max_train_s >= 0) {
+    args.insert(args.end(), {"--max-seconds", std::to_string(options.max_train_s)});
+  }
+  if (options.seed >= 0) args.insert(args.end(), {"--seed", std::to_string(options.seed)});
+  if (no_eval) args.push_back("--no-eval");
+  setenv("AUVRL_IN_NETNS", "1", 1);
+  std::vector<char*> cargs;
+  for (auto& a : args) cargs.push_back(a.data());
+  cargs.push_back(nullptr);
+  execv(netns.c_str(), cargs.data());
+  throw std::runtime_error("cannot run " + netns);
+}
+
 struct Subcommand {
   const char* name;
   const char* summary;
@@ -50,6 +123,7 @@ struct Subcommand {
 };
 
 const Subcommand kSubcommands[] = {
+    {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
     {"eval", "evaluate a policy or the PID baseline on test1/test2/fault/current/suite", run_eval},
 };
 

@@ -97,6 +97,16 @@ bool CommandLine::parse(int argc, const char* const* argv) {
   return true;
 }
 
+std::string CommandLine::find_value(int argc, const char* const* argv, const std::string& name) {
+  const std::string flag = "--" + name;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == flag && i + 1 < argc) return argv[i + 1];
+    if (arg.rfind(flag + "=", 0) == 0) return arg.substr(flag.size() + 1);
+  }
+  return "";
+}
+
 std::string CommandLine::usage() const {
   std::ostringstream out;
   out << "usage: " << program_ << " [options]\n" << summary_ << "\n\noptions:\n";

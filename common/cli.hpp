@@ -35,6 +35,10 @@ class CommandLine {
 
   std::string usage() const;
 
+  /// The value of --name in argv ("" if absent), before parse(): for a --config file whose
+  /// values the other options then override.
+  static std::string find_value(int argc, const char* const* argv, const std::string& name);
+
  private:
   struct Option {
     std::string name;

@@ -7,6 +7,7 @@
 #include "common/nn/mlp.hpp"
 #include "common/signals.hpp"
 #include "learner/bench.hpp"
+#include "learner/learner_config.hpp"
 #include "learner/learner_node.hpp"
 
 namespace {
@@ -38,11 +39,21 @@ int run_bench(const std::string& algo, const std::string& hidden, int batch, int
 
 int main(int argc, char** argv) {
   learner::LearnerNodeConfig config;
-  config.ddpg.state_dim = 23;
-  config.ddpg.action_dim = 6;
+  config.ddpg.state_dim = config.task.state_dim();
+  config.ddpg.action_dim = config.task.num_thrusters;
+  std::string config_path = cli::CommandLine::find_value(argc, argv, "config");
+  if (!config_path.empty()) {
+    try {
+      learner::read_learner_config_file(config_path, config);
+    } catch (const std::exception& e) {
+      std::cerr << "auv_learner: " << e.what() << "\n";
+      return 2;
+    }
+  }
   transport::TransportConfig transport_config;
-  std::string algo = "ddpg", hidden, actor_hidden, critic_hidden;
-  std::int64_t seed = 1, replay = static_cast<std::int64_t>(config.ddpg.replay_capacity);
+  std::string algo = learner::to_string(config.ddpg.algo), hidden, actor_hidden, critic_hidden;
+  std::int64_t seed = static_cast<std::int64_t>(config.ddpg.seed),
+               replay = static_cast<std::int64_t>(config.ddpg.replay_capacity);
   int threads = 1;
   bool bench = false, resume = false, keep_running = false;
   double bench_seconds = 2.0;
@@ -51,7 +62,11 @@ int main(int argc, char** argv) {
   cli::CommandLine cmd("auv_learner",
                        "Central learner: replay buffer and networks, DDPG/TD3 updates from the "
                        "actors' experience, weights broadcast, schedule, checkpoints.");
+  cmd.option("config", &config_path,
+             "run configuration (YAML: task, schedule, learner); the options below override it");
   cmd.option("algo", &algo, "ddpg or td3");
+  cmd.flag("her", &config.her, "hindsight relabelling (future strategy) with the task's reward");
+  cmd.option("her-k", &config.her_k, "future goals per real one");
   cmd.option("state-dim", &config.ddpg.state_dim, "observation size (the task's layout)");
   cmd.option("action-dim", &config.ddpg.action_dim, "action size (thrusters)");
   cmd.option("hidden", &hidden, "hidden sizes of both networks, e.g. 400-300");

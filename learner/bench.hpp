@@ -16,6 +16,10 @@ struct BenchCase {
   Algo algo = Algo::kDdpg;
   std::vector<int> hidden{256, 256};  ///< both actor and critic
   int batch = 256;
+  /// Threads for the products (nn::set_num_threads). More than one pays only on an otherwise
+  /// idle machine: each product ends at a barrier, and with more runnable threads than cores a
+  /// descheduled worker stalls the others for a time slice (measured here with the two cores
+  /// busy: 4-10 updates/s instead of hundreds).
   int threads = 1;
   int state_dim = 29;
   int action_dim = 6;

@@ -21,7 +21,9 @@ int main(int argc, char** argv) {
                        "Simulates K vehicles served over LCM (lockstep for training, real time for "
                        "demos), or runs thrust commands open loop from a CSV file.");
   cmd.option("vehicle", &vehicle_path, "vehicle file (YAML)");
-  cmd.option("vehicles", &server.num_vehicles, "number of vehicles K (ids 0..K-1)");
+  cmd.option("vehicles", &server.num_vehicles, "number of vehicles K");
+  cmd.option("first-vehicle-id", &server.first_vehicle_id,
+             "ids served: this .. this + K - 1 (several simulators on one bus)");
   cmd.flag("realtime", &realtime, "step at wall-clock rate with the latest command");
   cmd.option("realtime-factor", &server.realtime_factor, "real-time mode: sim seconds per second");
   cmd.option("heartbeat-period", &server.heartbeat_period_s, "heartbeat period, s");

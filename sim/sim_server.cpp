@@ -110,10 +110,11 @@ SimServer::SimServer(const VehicleModel& model, transport::Transport& transport,
   if (config_.num_vehicles < 1) throw std::invalid_argument("num_vehicles must be >= 1");
   if (!(config_.realtime_factor > 0)) throw std::invalid_argument("realtime_factor must be > 0");
   vehicles_.resize(static_cast<std::size_t>(config_.num_vehicles));
-  for (int id = 0; id < config_.num_vehicles; ++id) {
-    Vehicle& v = vehicles_[static_cast<std::size_t>(id)];
+  if (config_.first_vehicle_id < 0) throw std::invalid_argument("first_vehicle_id must be >= 0");
+  for (int i = 0; i < config_.num_vehicles; ++i) {
+    Vehicle& v = vehicles_[static_cast<std::size_t>(i)];
     v.held_command_n = ThrusterVector::Zero(model_.num_thrusters());
-    v.state_channel = channels::sim_state(id);
+    v.state_channel = channels::sim_state(config_.first_vehicle_id + i);
   }
 
   using transport::subscribe;
@@ -141,8 +142,11 @@ SimServer::~SimServer() {
 }
 
 const VehicleState* SimServer::vehicle(int id) const {
-  if (id < 0 || id >= config_.num_vehicles || !vehicles_[id].active) return nullptr;
-  return &vehicles_[id].state;
+  const int i = id - config_.first_vehicle_id;
+  if (i < 0 || i >= config_.num_vehicles || !vehicles_[static_cast<std::size_t>(i)].active) {
+    return nullptr;
+  }
+  return &vehicles_[static_cast<std::size_t>(i)].state;
 }
 
 void SimServer::poll(int timeout_ms) {
@@ -152,12 +156,12 @@ void SimServer::poll(int timeout_ms) {
 }
 
 SimServer::Vehicle* SimServer::addressed_vehicle(const std::string& channel, int vehicle_id) {
-  if (vehicle_id < 0 || vehicle_id >= config_.num_vehicles ||
-      channels::vehicle_id_of(channel) != vehicle_id) {
+  const int i = vehicle_id - config_.first_vehicle_id;
+  if (i < 0 || i >= config_.num_vehicles || channels::vehicle_id_of(channel) != vehicle_id) {
     ++counters_.dropped_vehicle_id;
     return nullptr;
   }
-  return &vehicles_[static_cast<std::size_t>(vehicle_id)];
+  return &vehicles_[static_cast<std::size_t>(i)];
 }
 
 bool SimServer::thrusters_valid(int num_thrusters, const std::vector<double>& values,
@@ -271,9 +275,10 @@ void SimServer::realtime_tick() {
   // Catch up at most a few steps after a stall rather than bursting through a backlog.
   int budget = 5;
   while (now >= next_realtime_step_ && budget-- > 0) {
-    for (int id = 0; id < config_.num_vehicles; ++id) {
-      Vehicle& vehicle = vehicles_[static_cast<std::size_t>(id)];
+    for (int i = 0; i < config_.num_vehicles; ++i) {
+      Vehicle& vehicle = vehicles_[static_cast<std::size_t>(i)];
       if (!vehicle.active) continue;
+      const int id = config_.first_vehicle_id + i;
       step_vehicle(id, vehicle, vehicle.held_command_n);
       publish_state(id, vehicle);
     }

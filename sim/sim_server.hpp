@@ -21,6 +21,9 @@ namespace auvrl::sim {
 /// How auv_sim serves its vehicles.
 struct SimServerConfig {
   int num_vehicles = 1;
+  /// Vehicle ids served: first_vehicle_id .. first_vehicle_id + num_vehicles - 1 (several
+  /// auv_sim processes on one bus, e.g. one per actor, each pinned beside its actor).
+  int first_vehicle_id = 0;
   bool lockstep = true;
   double realtime_factor = 1.0;     ///< real-time mode: simulated seconds per wall second
   double heartbeat_period_s = 1.0;  ///< wall-clock period of SIM_HEARTBEAT

@@ -166,9 +166,11 @@ class Mlp {
 /// tau = 1 copies. Throws std::invalid_argument if the specs differ.
 void soft_update(Mlp& target, const Mlp& source, float tau);
 
-/// Sets how many threads Eigen's matrix products may use (needs OpenMP; 1 otherwise). Programs
-/// linking this library start with 1: several learning processes share a machine, and one
-/// thread is what allocates nothing in the update loop.
+/// Sets how many threads the layer products may use (needs OpenMP; 1 otherwise): large products
+/// are split by columns. Programs linking this library start with 1: several learning processes
+/// share a machine, one thread is what allocates nothing in the update loop, and on a machine
+/// with more runnable threads than cores the products' barriers make several threads far
+/// slower than one.
 void set_num_threads(int n);
 /// The current setting of set_num_threads().
 int num_threads();

@@ -1,0 +1,33 @@
+#include "agent/actor_config.hpp"
+
+#include "common/task/task_yaml.hpp"
+
+namespace auvrl::agent {
+
+void read_actor_config_file(const std::string& path, ActorNodeConfig& c) {
+  config::Section root = config::load_file(path);
+  task::read_task_config(root.child("task"), c.task);
+  const task::GoalSchedule schedule =
+      task::read_goal_schedule(root.child("schedule"), task::GoalSchedule());
+  c.initial_beta_m = schedule.beta_m(0);
+  config::Section s = root.child("actor");
+  std::string noise = c.noise == ExplorationNoise::Kind::kNone       ? "none"
+                      : c.noise == ExplorationNoise::Kind::kGaussian ? "gaussian"
+                                                                     : "ou";
+  s.read("noise", noise);
+  try {
+    c.noise = parse_noise_kind(noise);
+  } catch (const std::invalid_argument& e) {
+    s.fail("noise", e.what());
+  }
+  s.read("noise_sigma", c.noise_sigma);
+  s.read("noise_theta", c.noise_theta);
+  s.read("max_transitions_per_message", c.max_transitions_per_message);
+  s.read("weights_request_period_s", c.weights_request_period_s);
+  s.read("weights_silence_s", c.weights_silence_s);
+  s.read("max_episodes", c.max_episodes);
+  s.finish();
+  config::finish_run_file(root);
+}
+
+}  // namespace auvrl::agent

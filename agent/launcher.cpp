@@ -1,0 +1,532 @@
+#include "agent/launcher.hpp"
+
+#include <unistd.h>
+
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/policy_weights_t.hpp>
+#include <auvrl_lcm/sim_heartbeat_t.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "agent/evaluation.hpp"
+#include "common/channels.hpp"
+#include "common/config/yaml_config.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+#include "common/process.hpp"
+#include "common/signals.hpp"
+#include "common/task/task_yaml.hpp"
+#include "common/transport.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace auvrl::agent {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+/// Everything the launcher reads from the run configuration.
+struct RunConfig {
+  RunSettings run;
+  task::TaskConfig task;
+  std::string vehicle_path;
+  std::int64_t learner_max_episodes = 0;
+};
+
+RunConfig read_run_config(const std::string& path) {
+  RunConfig c;
+  config::Section root = config::load_file(path);
+  std::string vehicle = "../vehicles/nessie7.yaml";
+  root.read("vehicle", vehicle);
+  c.vehicle_path = config::resolve_path(root, vehicle);
+  task::read_task_config(root.child("task"), c.task);
+  config::Section learner = root.child("learner");
+  learner.read("max_episodes", c.learner_max_episodes);
+  config::Section run = root.child("run");
+  run.read("actors", c.run.actors);
+  run.read("seed", c.run.seed);
+  run.read("max_train_s", c.run.max_train_s);
+  run.read("best_eval_period_s", c.run.best_eval_period_s);
+  run.read("best_eval_suite", c.run.best_eval_suite);
+  run.read("max_restarts", c.run.max_restarts);
+  run.read("restart_window_s", c.run.restart_window_s);
+  run.finish();
+  return c;
+}
+
+std::string timestamp() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return text;
+}
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+/// One supervised process: what to start, how often it was restarted.
+struct Role {
+  std::string name;
+  /// The command line for a start after `restarts` restarts.
+  std::function<std::vector<std::string>(std::size_t restarts)> argv;
+  std::string log_path;
+  std::unique_ptr<process::ChildProcess> proc;
+  std::deque<Clock::time_point> restarts;
+  Clock::time_point restart_due{};
+  bool waiting_restart = false;
+  bool finished = false;  ///< ended by itself, successfully, and should stay ended
+};
+
+/// A quick score of a policy: reached count first, then faster and closer holding.
+struct QuickScore {
+  int reached = 0;
+  int episodes = 0;
+  double mean_time_s = 1e9;
+  double mean_hold_m = 1e9;
+  bool better_than(const QuickScore& o) const {
+    if (reached != o.reached) return reached > o.reached;
+    return mean_time_s + 10.0 * mean_hold_m < o.mean_time_s + 10.0 * o.mean_hold_m;
+  }
+};
+
+QuickScore quick_evaluate(const sim::VehicleModel& model, const task::TaskConfig& task,
+                          const nn::Mlp& network, int suite_episodes) {
+  EvaluationConfig config;
+  config.task = task;
+  config.suite_episodes = suite_episodes;
+  config.suite_trajectories = 0;
+  PolicyController controller(network, task.state_dim(), task.num_thrusters);
+  const auto rows =
+      run_evaluation(model, config, controller,
+                     {Scenario::kTest1, Scenario::kTest2, Scenario::kFault, Scenario::kSuite}, "");
+  QuickScore s;
+  double time_sum = 0, hold_sum = 0;
+  for (const SummaryRow& r : rows) {
+    ++s.episodes;
+    if (!r.reached) continue;
+    ++s.reached;
+    time_sum += r.time_to_reach_s;
+    hold_sum += r.mean_error_after_reach_m;
+  }
+  if (s.reached > 0) {
+    s.mean_time_s = time_sum / s.reached;
+    s.mean_hold_m = hold_sum / s.reached;
+  }
+  return s;
+}
+
+std::string format_duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  const long total = std::lround(s);
+  std::ostringstream out;
+  if (total >= 3600) out << total / 3600 << "h";
+  out << std::setw(total >= 3600 ? 2 : 1) << std::setfill('0') << (total % 3600) / 60 << "m"
+      << std::setw(2) << std::setfill('0') << total % 60 << "s";
+  return out.str();
+}
+
+}  // namespace
+
+std::string prepare_run_directory(TrainOptions& o) {
+  if (o.resume) {
+    if (!fs::is_regular_file(fs::path(o.run_dir) / "config.yaml")) {
+      throw std::runtime_error("--resume " + o.run_dir + ": no config.yaml there (not a run)");
+    }
+    return (fs::path(o.run_dir) / "config.yaml").string();
+  }
+  if (o.config_path.empty() || !fs::is_regular_file(o.config_path)) {
+    throw std::runtime_error("configuration '" + o.config_path + "' not found");
+  }
+  read_run_config(o.config_path);  // a broken configuration fails here, before anything starts
+  if (o.run_dir.empty()) {
+    o.run_dir = (fs::path(o.source_dir) / "runs" /
+                 (fs::path(o.config_path).stem().string() + "-" + timestamp()))
+                    .string();
+  }
+  if (fs::exists(fs::path(o.run_dir) / "config.yaml")) {
+    throw std::runtime_error(o.run_dir + " already holds a run (use --resume to continue it)");
+  }
+  for (const char* sub : {"logs", "checkpoints", "eval", "plots", "processes"}) {
+    fs::create_directories(fs::path(o.run_dir) / sub);
+  }
+  // The copy must resolve the vehicle path the same way: make it absolute.
+  std::ifstream in(o.config_path);
+  std::ofstream out(fs::path(o.run_dir) / "config.yaml");
+  std::string line;
+  const RunConfig parsed = read_run_config(o.config_path);
+  out << "# Copied from " << fs::absolute(o.config_path).string() << " by auvrl train.\n";
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) == 0) {
+      out << "vehicle: " << fs::absolute(parsed.vehicle_path).lexically_normal().string() << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+  if (!out) throw std::runtime_error("cannot write " + o.run_dir + "/config.yaml");
+  std::ofstream howto(fs::path(o.run_dir) / "README.txt");
+  howto << "auvrl run directory\n"
+        << "  config.yaml       the configuration of this run\n"
+        << "  progress.csv      training progress (also on the terminal)\n"
+        << "  episodes.csv      one row per episode; learner.csv: the learner's figures\n"
+        << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
+        << "  checkpoints/      learner checkpoints (auvrl train --resume " << o.run_dir << ")\n"
+        << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
+        << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"
+        << "  processes/        each process's output\n"
+        << "Watch the running system with lcm-spy: scripts/spy.sh " << o.run_dir << "\n";
+  return (fs::path(o.run_dir) / "config.yaml").string();
+}
+
+int run_training(const TrainOptions& options, std::ostream& out) {
+  const fs::path run_dir = options.run_dir;
+  const std::string config_path = (run_dir / "config.yaml").string();
+  RunConfig rc = read_run_config(config_path);
+  if (options.actors >= 0) rc.run.actors = options.actors;
+  if (options.max_train_s >= 0) rc.run.max_train_s = options.max_train_s;
+  if (options.seed >= 0) rc.run.seed = static_cast<std::uint64_t>(options.seed);
+  const int cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  const int actors = rc.run.actors > 0 ? rc.run.actors : cpus;
+  const sim::VehicleModel model = sim::load_vehicle_file(rc.vehicle_path);
+  rc.task.num_thrusters = model.num_thrusters();
+  rc.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
+
+  // Time already trained in earlier invocations of this run (for --resume).
+  double trained_before_s = 0;
+  {
+    std::ifstream progress(run_dir / "progress.csv");
+    std::string line, last;
+    while (std::getline(progress, line)) {
+      if (!line.empty() && line[0] != 'w') last = line;
+    }
+    if (!last.empty()) trained_before_s = std::atof(last.c_str());
+  }
+  const bool has_checkpoint = !fs::is_empty(run_dir / "checkpoints");
+
+  signals::install_stop_handlers();
+  auto transport = transport::make_transport({});
+
+  // ---- What the run writes while it trains. ----
+  const bool new_files = !fs::exists(run_dir / "episodes.csv");
+  std::ofstream episodes_csv(run_dir / "episodes.csv", std::ios::app);
+  std::ofstream learner_csv(run_dir / "learner.csv", std::ios::app);
+  std::ofstream progress_csv(run_dir / "progress.csv", std::ios::app);
+  if (new_files) {
+    episodes_csv << "wall_s,actor_id,episode_id,policy_version,return,length_steps,success,"
+                    "final_distance_m,min_distance_m,beta_m,end_reason,thrust_energy\n";
+    learner_csv << "wall_s,updates,updates_per_s,transitions_received,transitions_per_s,"
+                   "buffer_size,critic_loss,actor_loss,mean_q,episodes,beta_m,weights_published\n";
+    progress_csv << "wall_s,episodes,success_rate,beta_m,env_steps_per_s,updates_per_s,"
+                    "best_suite_success\n";
+  }
+  const auto start = Clock::now();
+  const auto wall = [&] { return trained_before_s + seconds_since(start); };
+
+  std::deque<bool> recent_success;
+  std::int64_t episodes_seen = 0;
+  double beta_m = 0;
+  transport::subscribe<auvrl_lcm::episode_report_t>(
+      *transport, channels::kEpisode,
+      [&](const std::string&, const auvrl_lcm::episode_report_t& e) {
+        ++episodes_seen;
+        beta_m = e.beta_m;
+        recent_success.push_back(e.success);
+        if (recent_success.size() > 100) recent_success.pop_front();
+        episodes_csv << std::fixed << std::setprecision(3) << wall() << ',' << e.actor_id << ','
+                     << e.episode_id << ',' << e.policy_version << ',' << std::setprecision(4)
+                     << e.episode_return << ',' << e.length_steps << ',' << int(e.success) << ','
+                     << e.final_distance_m << ',' << e.min_distance_m << ',' << e.beta_m << ','
+                     << int(e.end_reason) << ',' << e.thrust_energy << '\n';
+      });
+  std::optional<auvrl_lcm::learner_stats_t> last_stats;
+  std::int64_t learner_episodes = 0;
+  transport::subscribe<auvrl_lcm::learner_stats_t>(
+      *transport, channels::kLearnerStats,
+      [&](const std::string&, const auvrl_lcm::learner_stats_t& s) {
+        last_stats = s;
+        learner_episodes = s.episodes;
+        learner_csv << std::fixed << std::setprecision(3) << wall() << ',' << s.updates << ','
+                    << std::setprecision(1) << s.updates_per_s << ',' << s.transitions_received
+                    << ',' << s.transitions_per_s << ',' << s.buffer_size << ','
+                    << std::setprecision(6) << s.critic_loss << ',' << s.actor_loss << ','
+                    << s.mean_q << ',' << s.episodes << ',' << s.beta_m << ','
+                    << s.weights_published << '\n';
+      });
+  std::map<int, std::pair<double, std::int64_t>> sim_steps;  // pid -> (rate, total)
+  transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
+      *transport, channels::kSimHeartbeat,
+      [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
+        sim_steps[h.pid] = {h.steps_per_s, h.steps_total};
+      });
+  transport::Latest<auvrl_lcm::policy_weights_t> weights(*transport, channels::kPolicyWeights, 4);
+
+  // ---- The processes. ----
+  const std::string bin = options.bin_dir + "/";
+  const fs::path proc_dir = run_dir / "processes";
+  std::vector<std::unique_ptr<Role>> roles;
+  const auto add_role = [&](const std::string& name,
+                            std::function<std::vector<std::string>(std::size_t)> argv) {
+    auto role = std::make_unique<Role>();
+    role->name = name;
+    role->argv = std::move(argv);
+    role->log_path = (proc_dir / (name + ".log")).string();
+    roles.push_back(std::move(role));
+    return roles.back().get();
+  };
+  const auto fixed = [](std::vector<std::string> argv) {
+    return [argv](std::size_t) { return argv; };
+  };
+  Role* logger =
+      add_role("logger", fixed({bin + "auv_logger", "--dir", (run_dir / "logs").string()}));
+  std::vector<Role*> sims, actor_roles;
+  for (int i = 0; i < actors; ++i) {
+    const std::string cpu = std::to_string(i % cpus);
+    sims.push_back(add_role("sim" + std::to_string(i),
+                            fixed({"/usr/bin/taskset", "-c", cpu, bin + "auv_sim", "--vehicle",
+                                   rc.vehicle_path, "--vehicles", "1", "--first-vehicle-id",
+                                   std::to_string(i)})));
+  }
+  Role* learner = add_role(
+      "learner",
+      fixed({bin + "auv_learner", "--config", config_path, "--checkpoint-dir",
+             (run_dir / "checkpoints").string(), "--policy-out", (run_dir / "policy.nn").string(),
+             "--max-actors", std::to_string(std::max(actors, 1))}));
+  for (int i = 0; i < actors; ++i) {
+    const std::uint64_t seed = rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
+    actor_roles.push_back(add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
+      // A restarted actor explores anew rather than repeating its first life.
+      return std::vector<std::string>{
+          bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
+          "--vehicle-id", std::to_string(i), "--seed", std::to_string(seed + 7919 * restarts),
+          "--pin-cpu", std::to_string(i % cpus), "--report-every", "100"};
+    }));
+  }
+  const auto start_role = [&](Role& r, bool resume_learner) {
+    std::vector<std::string> argv = r.argv(r.restarts.size());
+    if (&r == learner && resume_learner) argv.push_back("--resume");
+    r.proc = std::make_unique<process::ChildProcess>(argv, r.log_path, true);
+  };
+  start_role(*logger, false);
+  for (Role* s : sims) start_role(*s, false);
+  start_role(*learner, has_checkpoint);
+  for (Role* a : actor_roles) start_role(*a, false);
+  out << "auvrl train: " << actors << " actors on " << cpus << " CPUs, run " << run_dir.string()
+      << "\n  watch it: scripts/spy.sh " << run_dir.string() << "\n";
+
+  // ---- Supervise, show progress, keep the best policy. ----
+  const bool tty = isatty(STDOUT_FILENO) != 0;
+  auto next_progress = Clock::now();
+  auto next_best_eval = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                           std::chrono::duration<double>(rc.run.best_eval_period_s));
+  QuickScore best;
+  std::int64_t best_version = -1;
+  std::string stop_reason;
+  int exit_code = 0;
+  bool learner_done = false;
+  double last_print_s = -1e9;
+  while (true) {
+    transport->handle(100);
+    if (signals::stop_requested()) {
+      stop_reason = "stopped by the user";
+      exit_code = 130;
+      break;
+    }
+    if (rc.run.max_train_s > 0 && wall() >= rc.run.max_train_s) {
+      stop_reason = "training budget of " + format_duration(rc.run.max_train_s) + " used";
+      break;
+    }
+    // Supervision: restart what died, with back-off; give up on a role that keeps dying.
+    for (auto& r : roles) {
+      if (r->finished) continue;
+      if (r->waiting_restart) {
+        if (Clock::now() >= r->restart_due) {
+          r->waiting_restart = false;
+          out << (tty ? "\n" : "") << "auvrl train: restarting " << r->name << "\n";
+          start_role(*r, r.get() == learner && !fs::is_empty(run_dir / "checkpoints"));
+        }
+        continue;
+      }
+      if (r->proc->running()) continue;
+      const int status = r->proc->wait_for_exit(std::chrono::milliseconds(0));
+      const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      if (r.get() == learner && clean) {
+        learner_done = true;
+        r->finished = true;
+        continue;
+      }
+      while (!r->restarts.empty() && seconds_since(r->restarts.front()) > rc.run.restart_window_s) {
+        r->restarts.pop_front();
+      }
+      if (static_cast<int>(r->restarts.size()) >= rc.run.max_restarts) {
+        stop_reason = r->name + " failed " + std::to_string(r->restarts.size() + 1) +
+                      " times within " + format_duration(rc.run.restart_window_s) + " (see " +
+                      r->log_path + ")";
+        exit_code = 1;
+        break;
+      }
+      const double backoff = std::min(30.0, 0.5 * std::pow(2.0, r->restarts.size()));
+      out << (tty ? "\n" : "") << "auvrl train: " << r->name << " ended ("
+          << (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
+                                  : "exit " + std::to_string(WEXITSTATUS(status)))
+          << "); restarting in " << backoff << " s\n";
+      r->restarts.push_back(Clock::now());
+      r->waiting_restart = true;
+      r->restart_due = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(backoff));
+    }
+    if (exit_code == 1) break;
+    if (learner_done) {
+      stop_reason = "the learner's schedule ended";
+      break;
+    }
+
+    // Keep the best policy: evaluate the newest weights now and then.
+    if (Clock::now() >= next_best_eval) {
+      next_best_eval = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                          std::chrono::duration<double>(rc.run.best_eval_period_s));
+      if (auto w = weights.take(); w && w->version != best_version && w->version > 0) {
+        try {
+          nn::Mlp net = nn::network_from_bytes(
+              reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
+          const QuickScore score = quick_evaluate(model, rc.task, net, rc.run.best_eval_suite);
+          if (best_version < 0 || score.better_than(best)) {
+            best = score;
+            best_version = w->version;
+            nn::save_network_file((run_dir / "policy_best.nn").string(), net);
+          }
+        } catch (const std::exception& e) {
+          out << "auvrl train: quick evaluation failed: " << e.what() << "\n";
+        }
+      }
+    }
+
+    if (Clock::now() >= next_progress) {
+      next_progress = Clock::now() + std::chrono::seconds(1);
+      double steps_per_s = 0;
+      for (const auto& [pid, s] : sim_steps) steps_per_s += s.first;
+      int successes = 0;
+      for (bool s : recent_success) successes += s ? 1 : 0;
+      const double success_rate =
+          recent_success.empty() ? 0.0 : static_cast<double>(successes) / recent_success.size();
+      const double updates_per_s = last_stats ? last_stats->updates_per_s : 0.0;
+      double eta = -1;
+      if (rc.run.max_train_s > 0) {
+        eta = rc.run.max_train_s - wall();
+      } else if (rc.learner_max_episodes > 0 && learner_episodes > 0) {
+        eta = (rc.learner_max_episodes - learner_episodes) * (seconds_since(start) / episodes_seen);
+      }
+      const std::string best_text =
+          best_version < 0 ? "-"
+                           : std::to_string(best.reached) + "/" + std::to_string(best.episodes);
+      progress_csv << std::fixed << std::setprecision(1) << wall() << ',' << learner_episodes
+                   << ',' << std::setprecision(3) << success_rate << ',' << beta_m << ','
+                   << std::setprecision(0) << steps_per_s << ',' << updates_per_s << ','
+                   << (best_version < 0 ? 0.0 : static_cast<double>(best.reached) / best.episodes)
+                   << '\n';
+      progress_csv.flush();
+      episodes_csv.flush();
+      learner_csv.flush();
+      std::ostringstream line;
+      line << std::fixed << "episodes " << learner_episodes << "  success(100) "
+           << std::setprecision(0) << 100 * success_rate << "%  beta " << std::setprecision(2)
+           << beta_m << " m  env " << std::setprecision(0) << steps_per_s << " steps/s  updates "
+           << updates_per_s << "/s  best " << best_text << "  elapsed "
+           << format_duration(wall()) << "  left " << format_duration(eta);
+      if (tty) {
+        out << "\r" << line.str() << "   " << std::flush;
+      } else if (wall() - last_print_s >= 5.0) {
+        out << line.str() << "\n";
+        last_print_s = wall();
+      }
+    }
+  }
+  if (tty) out << "\n";
+  out << "auvrl train: " << stop_reason << "; stopping\n";
+
+  // ---- Stop: actors first (no more experience), then the learner (final checkpoint and
+  // policy), then the simulators and the logger (it flushes everything it received).
+  for (Role* a : actor_roles) {
+    if (a->proc) a->proc->terminate(std::chrono::seconds(5));
+  }
+  if (learner->proc) learner->proc->terminate(std::chrono::seconds(120));
+  for (Role* s : sims) {
+    if (s->proc) s->proc->terminate(std::chrono::seconds(5));
+  }
+  // Let the logger take in the last messages before it stops.
+  transport->handle(200);
+  if (logger->proc) logger->proc->terminate(std::chrono::seconds(10));
+  episodes_csv.flush();
+  learner_csv.flush();
+  progress_csv.flush();
+
+  out << "auvrl train: run directory " << run_dir.string() << "\n"
+      << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
+      << "  policy       " << (run_dir / "policy.nn").string()
+      << (best_version >= 0 ? "  (best so far: policy_best.nn, version " +
+                                  std::to_string(best_version) + ")"
+                            : "")
+      << "\n  logs         " << (run_dir / "logs").string() << "\n";
+  if (exit_code != 0) {
+    out << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+    return exit_code;
+  }
+  if (!options.evaluate) return 0;
+
+  // ---- Evaluation of the learned policy and the PID baseline, plots, report. ----
+  std::string policy_path = (run_dir / "policy.nn").string();
+  if (fs::exists(run_dir / "policy_best.nn")) {
+    // The last policy may be worse than the best seen: compare them on the quick evaluation.
+    try {
+      const nn::Mlp last = nn::network_from_bytes(nn::read_file(policy_path), 1);
+      const QuickScore last_score = quick_evaluate(model, rc.task, last, rc.run.best_eval_suite);
+      if (best.better_than(last_score)) policy_path = (run_dir / "policy_best.nn").string();
+    } catch (const std::exception&) {
+      policy_path = (run_dir / "policy_best.nn").string();
+    }
+  }
+  if (!fs::exists(policy_path)) {
+    out << "auvrl train: no policy was written; nothing to evaluate\n";
+    return 1;
+  }
+  out << "auvrl train: evaluating " << policy_path << " and the PID baseline\n";
+  EvaluationConfig eval;
+  eval.task = rc.task;
+  const std::vector<Scenario> all = parse_scenarios("all");
+  const nn::Mlp policy_net = nn::network_from_bytes(nn::read_file(policy_path), 1);
+  PolicyController policy(policy_net, rc.task.state_dim(), rc.task.num_thrusters);
+  const auto policy_rows =
+      run_evaluation(model, eval, policy, all, (run_dir / "eval" / "policy").string());
+  EvalRequest pid_request;
+  pid_request.controller = "pid";
+  EvaluationConfig pid_eval = eval;
+  auto pid = make_eval_controller(pid_request, model, pid_eval);
+  const auto pid_rows =
+      run_evaluation(model, pid_eval, *pid, all, (run_dir / "eval" / "pid").string());
+  std::ofstream(run_dir / "eval" / "selected_policy.txt") << policy_path << "\n";
+
+  const std::string plot = options.source_dir + "/scripts/plot_run.py";
+  if (fs::exists(plot) && fs::exists("/usr/bin/python3")) {
+    process::ChildProcess plotter({"/usr/bin/python3", plot, run_dir.string()},
+                                  (proc_dir / "plots.log").string());
+    const int status = plotter.wait_for_exit(std::chrono::minutes(5));
+    if (status != 0) out << "auvrl train: plotting failed (see " << plotter.log_path() << ")\n";
+  }
+  out << "\nlearned policy (" << policy_path << "):\n"
+      << format_summary_table(policy_rows) << "\nPID baseline:\n"
+      << format_summary_table(pid_rows) << "\nreport: " << (run_dir / "report.md").string()
+      << "\n";
+  return 0;
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,48 @@
+// `auvrl train`: the whole training system from one command. Starts auv_logger, one auv_sim
+// per actor (pinned to the actor's CPU: a lockstep round trip between CPUs costs inter-
+// processor interrupts on virtual machines), N auv_actor processes and auv_learner, each its
+// own process, in a run directory; shows progress; restarts what crashes; keeps the best
+// policy by a quick evaluation of the weights as they arrive; stops cleanly on Ctrl-C; and at
+// the end evaluates the policy and the PID baseline, draws the plots and writes the report.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+namespace auvrl::agent {
+
+/// The `run:` section of a run configuration.
+struct RunSettings {
+  int actors = 0;               ///< 0: one per CPU
+  std::uint64_t seed = 1;       ///< actor i uses seed * 1000 + i (+ a restart offset)
+  double max_train_s = 0.0;     ///< wall-clock training budget, s (0: until the learner ends)
+  double best_eval_period_s = 10.0;  ///< quick evaluation of the newest weights, s
+  int best_eval_suite = 20;          ///< way-points in that quick evaluation
+  int max_restarts = 5;         ///< a role restarted more often than this within...
+  double restart_window_s = 120.0;  ///< ...this many seconds stops the run
+};
+
+/// What `auvrl train` was asked.
+struct TrainOptions {
+  std::string config_path;   ///< a preset or configuration file (new runs)
+  std::string run_dir;       ///< the run directory (created for new runs)
+  bool resume = false;       ///< continue the run in run_dir
+  int actors = -1;           ///< overrides run.actors when >= 0
+  double max_train_s = -1;   ///< overrides run.max_train_s when >= 0
+  std::int64_t seed = -1;    ///< overrides run.seed when >= 0
+  bool evaluate = true;      ///< evaluation, plots and report after training
+  std::string bin_dir;       ///< where auv_sim, auv_actor, auv_learner, auv_logger are
+  std::string source_dir;    ///< the source tree (scripts/ for plots)
+};
+
+/// Creates the run directory of a new run (config copy, folders) or checks an existing one for
+/// --resume; returns the path of the run's configuration. Throws std::runtime_error naming
+/// what is wrong.
+std::string prepare_run_directory(TrainOptions& options);
+
+/// Runs training (already inside the network namespace, or with --network host), then the
+/// evaluation. Returns the process exit code.
+int run_training(const TrainOptions& options, std::ostream& out);
+
+}  // namespace auvrl::agent

@@ -1,0 +1,211 @@
+#include "common/config/yaml_config.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace auvrl::config {
+
+Section::Section(std::string file, std::string path, YAML::Node node)
+    : file_(std::move(file)), path_(std::move(path)), node_(std::move(node)) {
+  if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
+    throw ConfigError(file_ + ": '" + (path_.empty() ? std::string("top level") : path_) +
+                      "' must be a map of keys (line " + std::to_string(node_.Mark().line + 1) +
+                      ")");
+  }
+}
+
+std::string Section::key_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void Section::fail(const std::string& key, const std::string& what) const {
+  std::string where;
+  const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node();
+  if (n.IsDefined() && n.Mark().line >= 0) where = " (line " + std::to_string(n.Mark().line + 1) + ")";
+  throw ConfigError(file_ + ": '" + key_path(key) + "': " + what + where);
+}
+
+bool Section::has(const std::string& key) const {
+  return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
+}
+
+std::optional<YAML::Node> Section::get(const std::string& key) {
+  read_.insert(key);
+  if (!has(key)) return std::nullopt;
+  return node_[key];
+}
+
+double Section::number(const YAML::Node& node, const std::string& key) const {
+  double v = 0;
+  try {
+    if (!node.IsScalar()) throw YAML::Exception(YAML::Mark::null_mark(), "");
+    v = node.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected a number");
+  }
+  if (!std::isfinite(v)) fail(key, "expected a finite number");
+  return v;
+}
+
+std::int64_t Section::integer(const YAML::Node& node, const std::string& key) const {
+  try {
+    if (!node.IsScalar()) throw YAML::Exception(YAML::Mark::null_mark(), "");
+    return node.as<std::int64_t>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected an integer, got '" + (node.IsScalar() ? node.Scalar() : "a list or map") +
+                  "'");
+  }
+}
+
+void Section::read(const std::string& key, double& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    value = number(n, key);
+  }
+}
+
+void Section::read(const std::string& key, float& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    const double v = number(n, key);
+    if (std::abs(v) > std::numeric_limits<float>::max()) fail(key, "out of range");
+    value = static_cast<float>(v);
+  }
+}
+
+void Section::read(const std::string& key, int& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    const std::int64_t v = integer(n, key);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+      fail(key, "out of range");
+    }
+    value = static_cast<int>(v);
+  }
+}
+
+void Section::read(const std::string& key, std::int64_t& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    value = integer(n, key);
+  }
+}
+
+void Section::read(const std::string& key, std::uint64_t& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    const std::int64_t v = integer(n, key);
+    if (v < 0) fail(key, "expected a non-negative integer");
+    value = static_cast<std::uint64_t>(v);
+  }
+}
+
+void Section::read(const std::string& key, bool& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    try {
+      value = n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(key, "expected true or false");
+    }
+  }
+}
+
+void Section::read(const std::string& key, std::string& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    if (!n.IsScalar()) fail(key, "expected a string");
+    value = n.Scalar();
+  }
+}
+
+void Section::read(const std::string& key, std::vector<int>& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    if (!n.IsSequence()) fail(key, "expected a list of integers");
+    std::vector<int> out;
+    for (const auto& item : n) {
+      const std::int64_t v = integer(item, key);
+      if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) {
+        fail(key, "out of range");
+      }
+      out.push_back(static_cast<int>(v));
+    }
+    value = out;
+  }
+}
+
+void Section::read(const std::string& key, Eigen::Vector3d& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    if (!n.IsSequence() || n.size() != 3) fail(key, "expected a list of 3 numbers");
+    for (int i = 0; i < 3; ++i) value[i] = number(n[i], key);
+  }
+}
+
+void Section::read(const std::string& key, std::vector<std::vector<double>>& value) {
+  if (const auto found = get(key)) {
+    const YAML::Node& n = *found;
+    if (!n.IsSequence()) fail(key, "expected a list of lists of numbers");
+    std::vector<std::vector<double>> out;
+    for (const auto& row : n) {
+      if (!row.IsSequence()) fail(key, "expected a list of lists of numbers");
+      std::vector<double> r;
+      for (const auto& item : row) r.push_back(number(item, key));
+      out.push_back(r);
+    }
+    value = out;
+  }
+}
+
+Section Section::child(const std::string& key) {
+  const auto found = get(key);
+  return Section(file_, key_path(key), found ? *found : YAML::Node());
+}
+
+void Section::ignore(std::initializer_list<const char*> keys) {
+  for (const char* k : keys) read_.insert(k);
+}
+
+void Section::finish() const {
+  if (!node_.IsMap()) return;
+  for (const auto& entry : node_) {
+    const std::string key = entry.first.as<std::string>();
+    if (read_.count(key) == 0) {
+      std::string known;
+      for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;
+      throw ConfigError(file_ + ": '" + key_path(key) + "': unknown key (line " +
+                        std::to_string(entry.first.Mark().line + 1) + "; known here: " + known +
+                        ")");
+    }
+  }
+}
+
+Section load_file(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path + ": cannot read the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path + ": not valid YAML: " + e.what());
+  }
+  return Section(path, "", root);
+}
+
+}  // namespace auvrl::config
+
+namespace auvrl::config {
+
+void finish_run_file(Section& root) {
+  root.ignore({"vehicle", "task", "schedule", "learner", "actor", "run"});
+  root.finish();
+}
+
+std::string resolve_path(const Section& section, const std::string& path) {
+  if (path.empty() || path[0] == '/') return path;
+  const auto slash = section.file().rfind('/');
+  return slash == std::string::npos ? path : section.file().substr(0, slash + 1) + path;
+}
+
+}  // namespace auvrl::config

@@ -1,0 +1,84 @@
+// Strict reading of YAML configuration files (presets, run configurations): every value has a
+// default in the struct it fills, every key present must be one the reader knows (a typo is an
+// error, never a silent default), and every error names the file, the dotted key and the line.
+#pragma once
+
+#include <yaml-cpp/yaml.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace auvrl::config {
+
+/// A configuration file that cannot be used; the message names file, key and line.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A map in a configuration file. read() fills a target only when the key is present; finish()
+/// rejects any key that no read() asked for.
+class Section {
+ public:
+  Section(std::string file, std::string path, YAML::Node node);
+
+  bool has(const std::string& key) const;
+  void read(const std::string& key, double& value);
+  void read(const std::string& key, float& value);
+  void read(const std::string& key, int& value);
+  void read(const std::string& key, std::int64_t& value);
+  void read(const std::string& key, std::uint64_t& value);
+  void read(const std::string& key, bool& value);
+  void read(const std::string& key, std::string& value);
+  void read(const std::string& key, std::vector<int>& value);
+  void read(const std::string& key, Eigen::Vector3d& value);
+  /// A list of lists of numbers (e.g. schedule knots [[episode, beta], ...]).
+  void read(const std::string& key, std::vector<std::vector<double>>& value);
+  /// A sub-map (empty when absent).
+  Section child(const std::string& key);
+  /// Marks keys as known without reading them (sections other processes read).
+  void ignore(std::initializer_list<const char*> keys);
+  /// Throws ConfigError for any key nobody read.
+  void finish() const;
+
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+  const std::string& file() const { return file_; }
+  std::string key_path(const std::string& key) const;
+
+ private:
+  std::optional<YAML::Node> get(const std::string& key);
+  double number(const YAML::Node& node, const std::string& key) const;
+  std::int64_t integer(const YAML::Node& node, const std::string& key) const;
+
+  std::string file_;
+  std::string path_;
+  YAML::Node node_;
+  std::set<std::string> read_;
+};
+
+/// Loads a YAML file whose top level is a map; throws ConfigError naming the file on a
+/// missing file or a syntax error.
+Section load_file(const std::string& path);
+
+}  // namespace auvrl::config
+
+namespace auvrl::config {
+
+/// The top-level sections of a run configuration (config/presets/*.yaml). Every process reads
+/// the ones it needs and then calls finish_run_file(), which accepts these and rejects any
+/// other top-level key (a misspelt section is an error, not a silently ignored block).
+///   vehicle: path of the vehicle file, relative to the configuration's directory
+///   task:, schedule:   common/task (every process)
+///   learner:           auv_learner        actor:   auv_actor        run:   the launcher
+void finish_run_file(Section& root);
+
+/// A path from a configuration file: absolute as is, else relative to the file's directory.
+std::string resolve_path(const Section& section, const std::string& path);
+
+}  // namespace auvrl::config

@@ -1,0 +1,18 @@
+// The `task:` and `schedule:` sections of a run configuration (config/presets/*.yaml).
+#pragma once
+
+#include "common/config/yaml_config.hpp"
+#include "common/task/goal_schedule.hpp"
+#include "common/task/task.hpp"
+
+namespace auvrl::task {
+
+/// Fills `config` from a `task:` section (keys named as the TaskConfig members; absent keys
+/// keep their values) and validates it. Throws config::ConfigError naming file and key.
+void read_task_config(config::Section section, TaskConfig& config);
+
+/// A `schedule:` section: interpolation (log_linear | linear | step) and knots
+/// [[episode, beta_m], ...]; absent: `fallback`.
+GoalSchedule read_goal_schedule(config::Section section, const GoalSchedule& fallback);
+
+}  // namespace auvrl::task
