@@ -26,6 +26,8 @@ void read_actor_config_file(const std::string& path, ActorNodeConfig& c) {
   s.read("weights_request_period_s", c.weights_request_period_s);
   s.read("weights_silence_s", c.weights_silence_s);
   s.read("max_episodes", c.max_episodes);
+  s.read("max_learner_backlog", c.max_learner_backlog);
+  s.read("max_wait_s", c.max_wait_s);
   s.finish();
   config::finish_run_file(root);
 }

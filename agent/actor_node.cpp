@@ -33,11 +33,13 @@ class ActorNode::ExploringController final : public Controller {
   ActorNode& node_;
 };
 
-ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log)
+ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log,
+                     transport::Transport* lockstep_transport)
     : config_(std::move(config)),
       transport_(transport),
       log_(log),
-      link_(make_lockstep_link(transport, config_.vehicle_id, config_.task.num_thrusters)),
+      link_(make_lockstep_link(lockstep_transport ? *lockstep_transport : transport,
+                               config_.vehicle_id, config_.task.num_thrusters)),
       weights_(transport, channels::kPolicyWeights, 8),
       controller_(std::make_unique<ExploringController>(*this)),
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
@@ -56,6 +58,7 @@ void ActorNode::refresh_policy() {
   if (auto msg = weights_.take()) {
     last_weights_ = Clock::now();
     training_done_ = msg->training_done;
+    learner_backlog_ = msg->updates_owed;
     if (msg->version != policy_version_ || !controller_->policy_) {
       try {
         nn::Mlp network = nn::network_from_bytes(
@@ -90,7 +93,24 @@ void ActorNode::refresh_policy() {
   }
 }
 
+void ActorNode::wait_for_learner() {
+  if (config_.max_learner_backlog <= 0) return;
+  const auto start = Clock::now();
+  refresh_policy();
+  while (learner_backlog_ > config_.max_learner_backlog && !training_done_) {
+    // The learner broadcasts its weights (and backlog) as it works the backlog off; one
+    // that went silent does not hold the actor up for longer than max_wait_s.
+    if (std::chrono::duration<double>(Clock::now() - last_weights_).count() > config_.max_wait_s) {
+      break;
+    }
+    transport_.handle(20);
+    refresh_policy();
+  }
+  counters_.waited_s += std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 EpisodeSummary ActorNode::run_one_episode() {
+  wait_for_learner();
   refresh_policy();
   ++episode_id_;
   EpisodeOptions options;

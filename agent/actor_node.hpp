@@ -33,6 +33,10 @@ struct ActorNodeConfig {
   double weights_request_period_s = 0.5;  ///< while it has no policy, ask this often
   double weights_silence_s = 10.0;        ///< with a policy: ask again after this long unheard
   std::int64_t max_episodes = 0;          ///< stop after this many (0: until told to stop)
+  /// Flow control: before an episode, wait while the learner owes more updates than this
+  /// (0: never wait). Keeps the update-to-data ratio when actors outrun the learner.
+  double max_learner_backlog = 0.0;
+  double max_wait_s = 5.0;  ///< ...but never longer than this (a learner that went away)
 };
 
 /// Counters for logs and tests.
@@ -45,12 +49,16 @@ struct ActorCounters {
   std::int64_t weights_applied = 0;
   std::int64_t weights_rejected = 0;    ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
+  double waited_s = 0.0;  ///< time spent waiting for the learner (flow control)
 };
 
 /// The actor as a transport participant. Single-threaded.
 class ActorNode {
  public:
-  ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log);
+  /// Weights, experience and reports on `transport`; the vehicle in lockstep on
+  /// `lockstep_transport` (the same one, or a bus of its own shared only with its simulator).
+  ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log,
+            transport::Transport* lockstep_transport = nullptr);
   ~ActorNode();
   ActorNode(const ActorNode&) = delete;
   ActorNode& operator=(const ActorNode&) = delete;
@@ -81,7 +89,11 @@ class ActorNode {
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
   ActorCounters counters_;
+  /// Waits (flow control) while the learner's backlog is above the configured limit.
+  void wait_for_learner();
+
   std::int64_t policy_version_ = -1;  ///< -1: no policy yet (noise alone)
+  double learner_backlog_ = 0.0;      ///< from the newest weights message
   double beta_m_;
   bool training_done_ = false;
   std::int64_t batch_seq_ = 0;

@@ -56,7 +56,10 @@ int main(int argc, char** argv) {
   cmd.option("max-episodes", &config.max_episodes, "stop after this many (0: until stopped)");
   cmd.option("pin-cpu", &pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &report_every, "a log line every N episodes");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL of the system's bus");
+  std::string lockstep_url;
+  cmd.option("lockstep-lcm-url", &lockstep_url,
+             "the bus shared with its simulator only (default: the system's bus)");
   cmd.flag("allow-off-host", &transport_config.allow_off_host,
            "accept an LCM URL whose traffic can leave this host (no authentication!)");
   try {
@@ -83,8 +86,12 @@ int main(int argc, char** argv) {
 
   try {
     auto transport = transport::make_transport(transport_config);
+    std::unique_ptr<transport::Transport> lockstep;
+    if (!lockstep_url.empty()) {
+      lockstep = transport::make_transport({lockstep_url, transport_config.allow_off_host});
+    }
     signals::install_stop_handlers();
-    agent::ActorNode node(config, *transport, std::cerr);
+    agent::ActorNode node(config, *transport, std::cerr, lockstep.get());
     std::cerr << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
               << layout << " state (" << config.task.state_dim() << "), " << reward
               << " reward, " << noise << " noise, seed " << seed << "\n";

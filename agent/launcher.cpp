@@ -59,6 +59,8 @@ RunConfig read_run_config(const std::string& path) {
   run.read("max_train_s", c.run.max_train_s);
   run.read("best_eval_period_s", c.run.best_eval_period_s);
   run.read("best_eval_suite", c.run.best_eval_suite);
+  run.read("learner_cpu", c.run.learner_cpu);
+  run.read("private_lockstep_bus", c.run.private_lockstep_bus);
   run.read("max_restarts", c.run.max_restarts);
   run.read("restart_window_s", c.run.restart_window_s);
   run.finish();
@@ -290,26 +292,44 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   Role* logger =
       add_role("logger", fixed({bin + "auv_logger", "--dir", (run_dir / "logs").string()}));
   std::vector<Role*> sims, actor_roles;
-  for (int i = 0; i < actors; ++i) {
-    const std::string cpu = std::to_string(i % cpus);
-    sims.push_back(add_role("sim" + std::to_string(i),
-                            fixed({"/usr/bin/taskset", "-c", cpu, bin + "auv_sim", "--vehicle",
-                                   rc.vehicle_path, "--vehicles", "1", "--first-vehicle-id",
-                                   std::to_string(i)})));
+  // Actors (each beside its simulator) on the CPUs the learner does not have, if any.
+  std::vector<int> actor_cpus;
+  for (int c = 0; c < cpus; ++c) {
+    if (c != rc.run.learner_cpu || cpus == 1) actor_cpus.push_back(c);
   }
-  Role* learner = add_role(
-      "learner",
-      fixed({bin + "auv_learner", "--config", config_path, "--checkpoint-dir",
-             (run_dir / "checkpoints").string(), "--policy-out", (run_dir / "policy.nn").string(),
-             "--max-actors", std::to_string(std::max(actors, 1))}));
+  const auto lockstep_url = [&](int i) {
+    return "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576";
+  };
+  for (int i = 0; i < actors; ++i) {
+    const std::string cpu = std::to_string(actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()]);
+    std::vector<std::string> argv = {"/usr/bin/taskset", "-c", cpu, bin + "auv_sim", "--vehicle",
+                                     rc.vehicle_path, "--vehicles", "1", "--first-vehicle-id",
+                                     std::to_string(i)};
+    if (rc.run.private_lockstep_bus) argv.insert(argv.end(), {"--lockstep-lcm-url", lockstep_url(i)});
+    sims.push_back(add_role("sim" + std::to_string(i), fixed(argv)));
+  }
+  std::vector<std::string> learner_argv = {
+      bin + "auv_learner", "--config", config_path, "--checkpoint-dir",
+      (run_dir / "checkpoints").string(), "--policy-out", (run_dir / "policy.nn").string(),
+      "--max-actors", std::to_string(std::max(actors, 1))};
+  if (rc.run.learner_cpu >= 0 && rc.run.learner_cpu < cpus) {
+    learner_argv.insert(learner_argv.begin(),
+                        {"/usr/bin/taskset", "-c", std::to_string(rc.run.learner_cpu)});
+  }
+  Role* learner = add_role("learner", fixed(learner_argv));
   for (int i = 0; i < actors; ++i) {
     const std::uint64_t seed = rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
+    const int cpu = actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()];
+    const bool private_bus = rc.run.private_lockstep_bus;
+    const std::string url = lockstep_url(i);
     actor_roles.push_back(add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
       // A restarted actor explores anew rather than repeating its first life.
-      return std::vector<std::string>{
+      std::vector<std::string> argv = {
           bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
           "--vehicle-id", std::to_string(i), "--seed", std::to_string(seed + 7919 * restarts),
-          "--pin-cpu", std::to_string(i % cpus), "--report-every", "100"};
+          "--pin-cpu", std::to_string(cpu), "--report-every", "100"};
+      if (private_bus) argv.insert(argv.end(), {"--lockstep-lcm-url", url});
+      return argv;
     }));
   }
   const auto start_role = [&](Role& r, bool resume_learner) {

@@ -19,6 +19,11 @@ struct RunSettings {
   double max_train_s = 0.0;     ///< wall-clock training budget, s (0: until the learner ends)
   double best_eval_period_s = 10.0;  ///< quick evaluation of the newest weights, s
   int best_eval_suite = 20;          ///< way-points in that quick evaluation
+  /// CPU the learner is pinned to (-1: not pinned); actors then use the other CPUs.
+  int learner_cpu = -1;
+  /// Each simulator and its actor talk on a bus of their own (port 7668 + i), so nobody else
+  /// receives their ~2 x 20k messages/s; false puts everything on the system's bus.
+  bool private_lockstep_bus = true;
   int max_restarts = 5;         ///< a role restarted more often than this within...
   double restart_window_s = 120.0;  ///< ...this many seconds stops the run
 };

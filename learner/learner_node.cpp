@@ -228,6 +228,7 @@ auvrl_lcm::policy_weights_t LearnerNode::weights_message() const {
   msg.beta_m = beta_m();
   msg.episodes = counters_.episodes;
   msg.training_done = training_done();
+  msg.updates_owed = update_credit_;
   const std::vector<std::uint8_t> bytes = nn::network_to_bytes(ddpg_->actor());
   msg.num_bytes = static_cast<std::int32_t>(bytes.size());
   msg.network.assign(bytes.begin(), bytes.end());

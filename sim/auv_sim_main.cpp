@@ -27,7 +27,10 @@ int main(int argc, char** argv) {
   cmd.flag("realtime", &realtime, "step at wall-clock rate with the latest command");
   cmd.option("realtime-factor", &server.realtime_factor, "real-time mode: sim seconds per second");
   cmd.option("heartbeat-period", &server.heartbeat_period_s, "heartbeat period, s");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL of the system's bus (heartbeat)");
+  std::string lockstep_url;
+  cmd.option("lockstep-lcm-url", &lockstep_url,
+             "a bus of its own for commands and states (default: the system's bus)");
   cmd.flag("allow-off-host", &transport_config.allow_off_host,
            "accept an LCM URL whose traffic can leave this host (no authentication!)");
   cmd.option("open-loop", &open_loop_in, "open-loop tool: input CSV t,f1..fN (N)");
@@ -58,11 +61,15 @@ int main(int argc, char** argv) {
     server.lockstep = !realtime;
     server.vehicle_file = vehicle_path;
     auto transport = transport::make_transport(transport_config);
+    std::unique_ptr<transport::Transport> lockstep;
+    if (!lockstep_url.empty()) {
+      lockstep = transport::make_transport({lockstep_url, transport_config.allow_off_host});
+    }
     signals::install_stop_handlers();
-    sim::SimServer sim_server(model, *transport, server);
+    sim::SimServer sim_server(model, lockstep ? *lockstep : *transport, server, transport.get());
     std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " ("
               << vehicle_path << "), " << (realtime ? "real time" : "lockstep") << ", "
-              << transport_config.lcm_url << "\n";
+              << (lockstep_url.empty() ? transport_config.lcm_url : lockstep_url) << "\n";
     sim_server.run([] { return signals::stop_requested(); });
     const auto counters = sim_server.counters();
     std::cerr << "auv_sim: stopped after " << counters.steps_total << " steps, "

@@ -105,8 +105,11 @@ void state_message_from_measurement(const Measurement& measurement, const Vehicl
 }
 
 SimServer::SimServer(const VehicleModel& model, transport::Transport& transport,
-                     SimServerConfig config)
-    : model_(model), transport_(transport), config_(std::move(config)) {
+                     SimServerConfig config, transport::Transport* heartbeat_transport)
+    : model_(model),
+      transport_(transport),
+      heartbeat_transport_(heartbeat_transport ? *heartbeat_transport : transport),
+      config_(std::move(config)) {
   if (config_.num_vehicles < 1) throw std::invalid_argument("num_vehicles must be >= 1");
   if (!(config_.realtime_factor > 0)) throw std::invalid_argument("realtime_factor must be > 0");
   vehicles_.resize(static_cast<std::size_t>(config_.num_vehicles));
@@ -322,7 +325,7 @@ void SimServer::publish_heartbeat() {
   hb.dropped_non_finite = counters_.dropped_non_finite;
   hb.dropped_out_of_range = counters_.dropped_out_of_range;
   hb.dropped_not_reset = counters_.dropped_not_reset;
-  transport::publish(transport_, channels::kSimHeartbeat, hb);
+  transport::publish(heartbeat_transport_, channels::kSimHeartbeat, hb);
   next_heartbeat_ = now + std::chrono::duration_cast<Clock::duration>(
                               std::chrono::duration<double>(config_.heartbeat_period_s));
 }

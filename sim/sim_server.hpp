@@ -59,7 +59,11 @@ void state_message_from_measurement(const Measurement& measurement, const Vehicl
 /// Serves the vehicles of one model over a transport.
 class SimServer {
  public:
-  SimServer(const VehicleModel& model, transport::Transport& transport, SimServerConfig config);
+  /// Lockstep traffic (commands, resets, faults, states) on `transport`; the heartbeat on
+  /// `heartbeat_transport` (the same one, or the system's main bus when each simulator and its
+  /// actor have a lockstep bus of their own, so nobody else receives that traffic).
+  SimServer(const VehicleModel& model, transport::Transport& transport, SimServerConfig config,
+            transport::Transport* heartbeat_transport = nullptr);
   ~SimServer();
   SimServer(const SimServer&) = delete;
   SimServer& operator=(const SimServer&) = delete;
@@ -108,6 +112,7 @@ class SimServer {
 
   const VehicleModel& model_;
   transport::Transport& transport_;
+  transport::Transport& heartbeat_transport_;
   SimServerConfig config_;
   std::vector<Vehicle> vehicles_;
   SimServerCounters counters_;

@@ -82,7 +82,8 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
       for (int f = t; f < n && !matched; ++f) {
         const Eigen::Vector3d g = steps[f + 1].obs.position_ned_m.cast<float>().cast<double>();
         task::StateVector expect, expect2;
-        task::build_state(cfg, steps[t].obs, g, t > 0 ? steps[t - 1].action : task::ActionVector::Zero(6), expect);
+        task::build_state(cfg, steps[t].obs, g,
+                          t > 0 ? steps[t - 1].action : task::ActionVector::Zero(6), expect);
         if ((expect - batch.state.col(i)).cwiseAbs().maxCoeff() > 2e-4f) continue;
         task::build_state(cfg, steps[t + 1].obs, g, steps[t].action, expect2);
         EXPECT_LT((expect2 - batch.next_state.col(i)).cwiseAbs().maxCoeff(), 2e-4f);

@@ -91,9 +91,10 @@ DdpgConfig point_mass_config(Algo algo, std::uint64_t seed) {
   c.state_dim = PointMass::kStateDim;
   c.action_dim = PointMass::kActionDim;
   // Smaller and faster than the paper's preset: a task of four inputs needs no 400-300 networks;
-  // learning rates of 1e-3, tau 1e-2 and a horizon of ~10 steps (gamma 0.9) learn it in a few
-  // thousand updates. Measured over seeds 1-10 (300 episodes): DDPG 10/10 and TD3 9/10 runs at
-  // 100 % success, the tenth TD3 at 91 %.
+  // learning rates of 1e-3, tau 1e-2 and a horizon of ~10 steps (gamma 0.9) learn it within
+  // 300 episodes (at most 15,000 steps, one update each). Measured over seeds 1-10 with the
+  // AVX-512 kernels: all 20 runs (DDPG and TD3) at 95 % success or more, 18 at 100 %, 0.5-0.9 s
+  // each; with Eigen's products (AUVRL_NN_PORTABLE) seeds 1-3 reach 93-100 %.
   c.actor_hidden = {64, 64};
   c.critic_hidden = {64, 64};
   c.actor_lr = 1e-3f;
