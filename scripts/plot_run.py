@@ -21,10 +21,12 @@ import datetime
 import math
 import os
 import sys
+import traceback
 
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.lines  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -49,6 +51,7 @@ THRUSTER_ROLE = ["fwd port", "fwd stbd", "lat rear", "lat front", "vert rear", "
 END_REASONS = ["reached", "time_limit", "left_region", "flipped", "blow_up", "sim_timeout"]
 DPI = 100
 MAX_SCATTER = 20000  # per-episode points drawn at most (every k-th beyond)
+DIST_FLOOR = 1e-5  # distances below are drawn at this value on log axes
 
 # Plot files this script writes; stale ones (from an earlier call with more inputs) are removed.
 OWN_PLOTS = [f"eval_{s}_{k}.png" for s in PAPER_SCENARIOS for k in ("3d", "position",
@@ -353,6 +356,17 @@ def save(fig, plots_dir, name, written):
 # ---------------------------------------------------------------------------------------------
 # Evaluation figures
 # ---------------------------------------------------------------------------------------------
+def box_floor(pts):
+    """(deepest z of the box set_3d_limits draws, its largest span)."""
+    pts = np.asarray(pts, dtype=float)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    if pts.size == 0:
+        return None, 1.0
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    span = np.maximum(hi - lo, 1.0)
+    return hi[2] + 0.08 * span[2], float(span.max())
+
+
 def set_3d_limits(ax, pts):
     """Equal scale on the three axes around the points (east, north, depth)."""
     pts = np.asarray(pts, dtype=float)
@@ -370,11 +384,29 @@ def set_3d_limits(ax, pts):
     ax.set_box_aspect(tuple(box))
 
 
-def draw_3d(ax, traj, goal, color, label, reach_t):
+def draw_3d(ax, traj, goal, color, label, reach_t, floor_z=None, arrow_m=0.8):
     """One path in a 3-D axes: matplotlib's x = east (y), y = north (x), z = depth, inverted so
     that depth points down (a right-handed east-north-up view of the NED path)."""
     e, n, d = traj["y"], traj["x"], traj["z"]
     ax.plot(e, n, d, color=color, lw=1.6, label=f"{label} path")
+    if floor_z is not None:  # the horizontal track on the floor of the box
+        ax.plot(e, n, np.full_like(d, floor_z), color="0.45", lw=0.9, ls=":",
+                label="horizontal track (on the floor)")
+    if "psi" in traj and len(e) > 1:  # heading every 2 s, while the vehicle moves
+        idx, last = [], None
+        for i in range(len(e)):
+            p = np.array([e[i], n[i], d[i]])
+            if not np.all(np.isfinite(p)) or not math.isfinite(traj["psi"][i]):
+                continue
+            if last is None or (traj["t"][i] - traj["t"][last] >= 2.0 - 1e-6 and
+                                np.linalg.norm(p - [e[last], n[last], d[last]]) > 0.4 * arrow_m):
+                idx.append(i)
+                last = i
+        if idx:
+            psi = traj["psi"][idx]
+            ax.quiver(e[idx], n[idx], d[idx], np.sin(psi), np.cos(psi), np.zeros_like(psi),
+                      length=arrow_m, color="black", lw=0.9, arrow_length_ratio=0.35,
+                      label="heading (every 2 s while moving)")
     ax.scatter([e[0]], [n[0]], [d[0]], color="tab:green", marker="o", s=45, label="start",
                depthshade=False)
     ax.scatter([e[-1]], [n[-1]], [d[-1]], color=color, marker="s", s=25, label="end (70 s)",
@@ -418,11 +450,6 @@ def reach_text(t_reach, src):
 
 def plot_scenario(ctrls, scenario, plots_dir, written):
     panels = scenario_panels(ctrls, scenario)
-    for c in ctrls:
-        if c.summary and not c.rows(scenario):
-            NOTES.miss(f"{scenario} in {os.path.relpath(c.dir, c.run)}/summary.csv")
-        if not c.trajectory_episodes(scenario):
-            NOTES.miss(f"{os.path.relpath(c.dir, c.run)}/trajectories/{scenario}_0.csv")
     if not panels:
         return []
     ncol = len(panels)
@@ -436,9 +463,10 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
         pts += list(np.column_stack([traj["y"], traj["x"], traj["z"]]))
         if goal is not None:
             pts.append(np.array([goal[1], goal[0], goal[2]]))
+    zmax, span = box_floor(pts)
     for k, (c, ep, traj, goal, t_reach, src) in enumerate(panels):
         ax = fig.add_subplot(1, ncol, k + 1, projection="3d")
-        draw_3d(ax, traj, goal, c.color, c.label, t_reach)
+        draw_3d(ax, traj, goal, c.color, c.label, t_reach, floor_z=zmax, arrow_m=0.09 * span)
         set_3d_limits(ax, pts)
         ax.view_init(elev=22, azim=-60)
         ax.set_title(f"{c.label}\n{reach_text(t_reach, src)}", fontsize=10)
@@ -468,18 +496,19 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
         if k == 0:
             ax.set_ylabel("position [m]")
         ax = axes[1][k]
-        dist = np.clip(traj["distance_m"], 1e-4, None)
+        dist = np.clip(traj["distance_m"], DIST_FLOOR, None)
         ax.semilogy(traj["t"], dist, color=c.color, lw=1.5, label="distance to way-point")
         ax.axhline(REACH_M, color="gray", ls="--", lw=1.0, label=f"{REACH_M} m")
         if math.isfinite(t_reach):
             ax.axvline(t_reach, color="black", ls=":", lw=1.2)
-        ax.grid(True, which="both", alpha=0.3)
+        ax.grid(True, alpha=0.4)
         ax.legend(loc="upper right", fontsize=7)
         ax.set_xlabel("t [s]")
         if k == 0:
             ax.set_ylabel("distance [m] (log)")
     fig.suptitle(f"{title}: position against time", fontsize=11)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.07 if ncol > 1 else 0.12, right=0.98, bottom=0.08, top=0.9,
+                        hspace=0.12, wspace=0.05)
     names.append(save(fig, plots_dir, f"eval_{scenario}_position.png", written))
 
     # --- The six thrusters (paper Fig. 4b, 5b, 8b): realised thrust, command faint. ---
@@ -508,18 +537,27 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
             if real is not None and cmd is not None:
                 pc, pr = np.nanmax(np.abs(cmd)), np.nanmax(np.abs(real))
                 if pc > 1.0 and pr < 0.5 * pc:
-                    ax.text(0.99, 0.9, f"realised peak {pr:.1f} N = {100 * pr / pc:.0f} % of "
+                    ax.text(0.99, 0.06, f"realised peak {pr:.1f} N = {100 * pr / pc:.0f} % of "
                             f"commanded peak {pc:.1f} N", transform=ax.transAxes, ha="right",
-                            va="top", fontsize=7.5, color="darkred",
+                            va="bottom", fontsize=7.5, color="darkred",
                             bbox=dict(fc="white", ec="none", alpha=0.8))
             ax.tick_params(labelsize=7)
-        axes[0][k].set_title(f"{c.label}: thruster outputs ({reach_text(t_reach, src)})",
-                             fontsize=10)
-        axes[0][k].legend(loc="upper right", fontsize=7, ncol=2)
+        axes[0][k].set_title(f"{c.label}: {reach_text(t_reach, src)}", fontsize=10)
         axes[-1][k].set_xlabel("t [s]")
-    fig.suptitle(f"{title}: thrust per thruster (realised after delay, lag, slew and "
-                 "efficiency; dotted: reach time)", fontsize=10)
-    fig.tight_layout()
+    handles = [matplotlib.lines.Line2D([], [], color=c.color, lw=1.4,
+                                       label=f"realised thrust, {c.label}")
+               for c, *_ in panels]
+    handles += [matplotlib.lines.Line2D([], [], color="gray", lw=0.9, ls="--",
+                                        label="commanded thrust"),
+                matplotlib.lines.Line2D([], [], color="black", lw=1.0, ls=":",
+                                        label=f"within {REACH_M} m")]
+    fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8,
+               bbox_to_anchor=(0.5, 0.965), frameon=False)
+    fig.suptitle(f"{title}: thruster outputs (realised: after delay, lag, slew and "
+                 "efficiency)", fontsize=10.5)
+    top = 1 - 0.85 / fig.get_figheight()
+    fig.subplots_adjust(left=0.08 if ncol > 1 else 0.13, right=0.98, bottom=0.06, top=top,
+                        hspace=0.15, wspace=0.05)
     names.append(save(fig, plots_dir, f"eval_{scenario}_thrusters.png", written))
     return names
 
@@ -539,16 +577,17 @@ def plot_distance_overview(ctrls, plots_dir, written):
     for k, (c, st) in enumerate(have):
         ax = axes[0][k]
         for s, traj in st:
-            ax.semilogy(traj["t"], np.clip(traj["distance_m"], 1e-4, None),
+            ax.semilogy(traj["t"], np.clip(traj["distance_m"], DIST_FLOOR, None),
                         color=colors.get(s), lw=1.4, label=s)
         ax.axhline(REACH_M, color="gray", ls="--", lw=1.0, label=f"{REACH_M} m")
         ax.set_title(c.label, fontsize=10)
         ax.set_xlabel("t [s]")
-        ax.grid(True, which="both", alpha=0.3)
+        ax.grid(True, alpha=0.4)
         ax.legend(fontsize=8)
     axes[0][0].set_ylabel("distance to way-point [m] (log)")
     fig.suptitle("distance to the way-point, every scenario", fontsize=11)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.07 if len(have) > 1 else 0.12, right=0.98, bottom=0.12,
+                        top=0.86, wspace=0.05)
     return save(fig, plots_dir, "eval_distance.png", written)
 
 
@@ -556,9 +595,6 @@ def plot_suite(ctrls, plots_dir, written):
     names = []
     with_rows = [(c, c.rows(SUITE)) for c in ctrls]
     with_rows = [(c, r) for c, r in with_rows if r]
-    for c in ctrls:
-        if c.summary and not c.rows(SUITE):
-            NOTES.miss(f"suite in {os.path.relpath(c.dir, c.run)}/summary.csv")
     if with_rows:
         fig, axes = plt.subplots(2, 3, figsize=(15, 8.2))
         width = 0.8 / len(with_rows)
@@ -566,7 +602,7 @@ def plot_suite(ctrls, plots_dir, written):
         ax = axes[0][0]
         reasons = sorted({r["end_reason"] or "?" for _, rows in with_rows for r in rows},
                          key=lambda s: (END_REASONS.index(s) if s in END_REASONS else 99, s))
-        reasons = ["reached (any time)"] + reasons
+        reasons = ["ever"] + reasons
         for j, (c, rows) in enumerate(with_rows):
             counts = [sum(r["reached"] for r in rows)]
             counts += [sum(1 for r in rows if (r["end_reason"] or "?") == s)
@@ -577,10 +613,10 @@ def plot_suite(ctrls, plots_dir, written):
                 ax.text(b.get_x() + b.get_width() / 2, v, str(v), ha="center", va="bottom",
                         fontsize=7)
         ax.set_xticks(np.arange(len(reasons)))
-        ax.set_xticklabels([f"{s}" if i else f"reached\nwithin {REACH_M} m"
-                            for i, s in enumerate(reasons)], fontsize=7, rotation=20)
+        ax.set_xticklabels([f"end:\n{s}" if i else f"within {REACH_M} m\nat some time"
+                            for i, s in enumerate(reasons)], fontsize=8)
         ax.set_ylabel("episodes")
-        ax.set_title("outcome (end reason: state at 70 s)", fontsize=10)
+        ax.set_title("outcome (end: the episode's end reason)", fontsize=10)
         ax.legend(fontsize=7)
         ax.margins(y=0.15)
 
@@ -594,18 +630,16 @@ def plot_suite(ctrls, plots_dir, written):
                 no_data(ax, f"no {key} values")
                 ax.set_title(title, fontsize=10)
                 return
-            if log:
-                pos = allv[allv > 0]
-                lo = pos.min() if pos.size else 1e-6
-                hi = max(allv.max(), lo * 10)
+            pos = allv[allv > 0]
+            if log and pos.size and pos.max() > 30 * pos.min():  # over 1.5 decades: log bins
+                lo, hi = pos.min(), pos.max() * 1.001
                 bins = np.logspace(math.log10(lo), math.log10(hi), 25)
                 ax.set_xscale("log")
             else:
                 lo, hi = allv.min(), allv.max()
                 bins = np.linspace(lo, hi if hi > lo else lo + 1, 25)
             for c, v in vals:
-                if log:
-                    v = np.clip(v, bins[0], None)
+                v = np.clip(v, bins[0], None)
                 ax.hist(v, bins=bins, histtype="stepfilled", alpha=0.35, color=c.color)
                 med = np.median(v) if v.size else math.nan
                 ax.hist(v, bins=bins, histtype="step", lw=1.5, color=c.color,
@@ -660,7 +694,8 @@ def plot_suite(ctrls, plots_dir, written):
             ax.set_title("same way-point, both controllers", fontsize=10)
         fig.suptitle("suite: random way-points from [0, 0, 5] (auvrl eval --scenario suite)",
                      fontsize=11)
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.05, right=0.98, bottom=0.08, top=0.91, hspace=0.38,
+                            wspace=0.22)
         names.append(save(fig, plots_dir, "suite_overview.png", written))
 
     # --- The suite trajectories that were saved (the first 10 by default). ---
@@ -778,7 +813,7 @@ class Training:
         return max(m) if m else math.nan
 
 
-def plot_training(tr, plots_dir, written):
+def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
     if not tr.any():
         return []
     wall = tr.wall_max()
@@ -791,7 +826,7 @@ def plot_training(tr, plots_dir, written):
     n = 0 if tr.ep is None else tr.ep["n"].size
     w = window_for(n)
     names = []
-    for mode in ("episodes", "time"):
+    for mode in modes:
         fig, axes = plt.subplots(3, 3, figsize=(15, 10.5), squeeze=False)
         if mode == "episodes":
             def xs(d, src):
@@ -849,11 +884,11 @@ def plot_training(tr, plots_dir, written):
                     label="best policy, quick suite")
 
         def ep_dist(ax, x, d):
-            scatter(ax, x, np.clip(d["final_distance_m"], 1e-4, None), "tab:red",
+            scatter(ax, x, np.clip(d["final_distance_m"], DIST_FLOOR, None), "tab:red",
                     "final, per episode")
-            ax.plot(x, np.clip(rolling_median(d["final_distance_m"], w), 1e-4, None),
+            ax.plot(x, np.clip(rolling_median(d["final_distance_m"], w), DIST_FLOOR, None),
                     color="darkred", lw=1.5, label=f"final, median of last {w}")
-            ax.plot(x, np.clip(rolling_median(d["min_distance_m"], w), 1e-4, None),
+            ax.plot(x, np.clip(rolling_median(d["min_distance_m"], w), DIST_FLOOR, None),
                     color="tab:orange", lw=1.2, label=f"closest, median of last {w}")
 
         def beta_of(key):
@@ -908,7 +943,8 @@ def plot_training(tr, plots_dir, written):
                 ax.set_xlabel(xlabel, fontsize=8)
         fig.suptitle(f"training against {xlabel.split(' (')[0]} ({n} episodes, "
                      f"{fmt_duration(wall)} wall-clock)", fontsize=11)
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.06, right=0.98, bottom=0.06, top=0.93, hspace=0.35,
+                            wspace=0.25)
         names.append(save(fig, plots_dir, f"training_vs_{mode}.png", written))
     return names
 
@@ -1138,7 +1174,8 @@ def write_report(run, ctrls, tr, figures, path):
     if not NOTES.missing and not NOTES.damaged:
         L.append("None: every input was present and readable.")
     for m in NOTES.missing:
-        L.append(f"- missing: `{m.split(' ')[0]}`" + (m[len(m.split(' ')[0]):]))
+        head = m.split(" ")[0].rstrip(":")
+        L.append(f"- missing: `{head}`{m[len(head):]}")
     cap = 50
     for d in NOTES.damaged[:cap]:
         L.append(f"- {d}")
@@ -1149,6 +1186,50 @@ def write_report(run, ctrls, tr, figures, path):
     with open(tmp, "w", encoding="utf-8") as f:
         f.write("\n".join(L))
     os.replace(tmp, path)
+
+
+CONTEXT = {}  # what the figure jobs draw from (set before the worker processes fork)
+
+
+def check_and_load(ctrls):
+    """Names what the evaluation lacks and reads every trajectory (once, before forking)."""
+    for c in ctrls:
+        rel = os.path.relpath(c.dir, c.run)
+        for s in PAPER_SCENARIOS + (SUITE,):
+            if c.summary and not c.rows(s):
+                NOTES.miss(f"{rel}/summary.csv: no {s} rows")
+        for s in PAPER_SCENARIOS:
+            if not c.trajectory_episodes(s):
+                NOTES.miss(f"{rel}/trajectories/{s}_0.csv")
+        for s in PAPER_SCENARIOS + (SUITE,):
+            for ep in c.trajectory_episodes(s):
+                c.trajectory(s, ep)
+
+
+def run_job(job):
+    """Draws one group of figures; returns (files written, missing, damaged). A failure is
+    reported and the other figures are still drawn."""
+    global NOTES
+    kind, arg = job
+    saved, NOTES = NOTES, Notes()
+    written = []
+    ctrls, tr, plots_dir = CONTEXT["ctrls"], CONTEXT["tr"], CONTEXT["plots_dir"]
+    try:
+        if kind == "scenario":
+            plot_scenario(ctrls, arg, plots_dir, written)
+        elif kind == "distance":
+            plot_distance_overview(ctrls, plots_dir, written)
+        elif kind == "suite":
+            plot_suite(ctrls, plots_dir, written)
+        elif kind == "training":
+            plot_training(tr, plots_dir, written, modes=(arg,))
+    except Exception as e:  # a figure must not cost the report
+        traceback.print_exc()
+        NOTES.damage(f"figures {kind} {arg or ''}: drawing failed ({type(e).__name__}: {e})")
+        plt.close("all")
+    finally:
+        notes, NOTES = NOTES, saved
+    return written, notes.missing, notes.damaged
 
 
 def main(argv):
@@ -1168,14 +1249,31 @@ def main(argv):
         return 1
     plt.rcParams.update({"figure.max_open_warning": 0, "axes.titlesize": 10})
 
-    written = []
     ctrls = find_controllers(run)
-    for s in PAPER_SCENARIOS:
-        plot_scenario(ctrls, s, plots_dir, written)
-    plot_distance_overview(ctrls, plots_dir, written)
-    plot_suite(ctrls, plots_dir, written)
+    check_and_load(ctrls)
     tr = Training(run)
-    plot_training(tr, plots_dir, written)
+    CONTEXT.update(ctrls=ctrls, tr=tr, plots_dir=plots_dir)
+    jobs = [("scenario", s) for s in PAPER_SCENARIOS] + [("distance", None), ("suite", None)]
+    if tr.any():
+        jobs += [("training", "episodes"), ("training", "time")]
+    results = None
+    workers = min(len(jobs), os.cpu_count() or 1)
+    if workers > 1:
+        try:  # one figure job per process: the figures take seconds each to draw
+            import multiprocessing
+            with multiprocessing.get_context("fork").Pool(workers) as pool:
+                results = pool.map(run_job, jobs)
+        except Exception as e:  # no fork or no semaphores here: draw them one by one
+            print(f"plot_run: parallel drawing unavailable ({e}); drawing serially",
+                  file=sys.stderr)
+            results = None
+    if results is None:
+        results = [run_job(j) for j in jobs]
+    written = []
+    for names, missing, damaged in results:
+        written += names
+        NOTES.missing += missing
+        NOTES.damaged += damaged
     for f in OWN_PLOTS:  # stale figures of an earlier call with more inputs
         if f not in written and os.path.isfile(os.path.join(plots_dir, f)):
             os.remove(os.path.join(plots_dir, f))

@@ -1,12 +1,18 @@
-// Environment steps per second of the training system (one auv_sim, one auv_learner, N
-// auv_actor processes), measured from auv_sim's heartbeat over a window after a warm-up.
-// Prints: training actors=N seconds=S env_steps_per_s=X updates_per_s=Y
+// Environment steps per second of the training system (auv_learner, N auv_actor processes and
+// their simulators), measured from auv_sim's heartbeats over a window after a warm-up, in two
+// placements: "shared" (one auv_sim for all, everything on one bus, nothing pinned) and
+// "pinned" (what auvrl train does: one auv_sim per actor pinned to the actor's CPU, a private
+// lockstep bus per pair). The learner updates at the given ratio, without flow control.
+// Prints: training placement=P actors=N seconds=S env_steps_per_s=X updates_per_s=Y
 // Run inside a private network namespace: scripts/netns.sh build/bin/bench_training_rate
+#include <unistd.h>
+
 #include <auvrl_lcm/learner_stats_t.hpp>
 #include <auvrl_lcm/sim_heartbeat_t.hpp>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <map>
 
 #include "child_process.hpp"
 #include "common/channels.hpp"
@@ -18,55 +24,71 @@ namespace {
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
 
-void run_case(int actors, double seconds, const std::string& learner_ratio) {
+void run_case(int actors, double seconds, const std::string& learner_ratio, bool pinned) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
   auto monitor = transport::make_transport({});
-  transport::Latest<auvrl_lcm::sim_heartbeat_t> heartbeat(*monitor, channels::kSimHeartbeat);
+  std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
+  transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
+      *monitor, channels::kSimHeartbeat,
+      [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) { heartbeats[h.pid] = h; });
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*monitor, channels::kLearnerStats);
-  test_support::ChildProcess sim(
-      {test_support::bin_path("auv_sim"), "--vehicles", std::to_string(actors),
-       "--heartbeat-period", "0.25"},
-      dir + "/sim.log");
+  std::vector<std::unique_ptr<test_support::ChildProcess>> procs;
+  const auto url = [](int i) {
+    return "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576";
+  };
+  const int cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  for (int i = 0; i < (pinned ? actors : 1); ++i) {
+    std::vector<std::string> argv = {test_support::bin_path("auv_sim"), "--heartbeat-period",
+                                     "0.25"};
+    if (pinned) {
+      argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(i % cpus)});
+      argv.insert(argv.end(), {"--first-vehicle-id", std::to_string(i), "--lockstep-lcm-url", url(i)});
+    } else {
+      argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
+    }
+    procs.push_back(std::make_unique<test_support::ChildProcess>(
+        argv, dir + "/sim" + std::to_string(i) + ".log"));
+  }
   test_support::ChildProcess learner(
       {test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden", "64-64", "--batch",
        "256", "--state-dim", "23", "--updates-per-transition", learner_ratio, "--warmup", "5000",
        "--replay", "200000"},
       dir + "/learner.log");
-  std::vector<std::unique_ptr<test_support::ChildProcess>> procs;
   for (int id = 0; id < actors; ++id) {
-    procs.push_back(std::make_unique<test_support::ChildProcess>(
-        std::vector<std::string>{test_support::bin_path("auv_actor"), "--actor-id",
-                                 std::to_string(id), "--seed", std::to_string(id + 1),
-                                 "--reward", "shaped", "--noise", "gaussian"},
-        dir + "/actor" + std::to_string(id) + ".log"));
-  }
-  const auto wait_heartbeat = [&](double for_s) {
-    std::optional<auvrl_lcm::sim_heartbeat_t> hb;
-    const auto end = Clock::now() + std::chrono::duration<double>(for_s);
-    while (Clock::now() < end) {
-      monitor->handle(50);
-      if (auto h = heartbeat.take()) hb = h;
+    std::vector<std::string> argv = {test_support::bin_path("auv_actor"), "--actor-id",
+                                     std::to_string(id), "--seed", std::to_string(id + 1),
+                                     "--reward", "shaped", "--noise", "gaussian", "--layout",
+                                     "extended"};
+    if (pinned) {
+      argv.insert(argv.end(), {"--pin-cpu", std::to_string(id % cpus), "--lockstep-lcm-url", url(id)});
     }
-    return hb;
+    procs.push_back(std::make_unique<test_support::ChildProcess>(
+        argv, dir + "/actor" + std::to_string(id) + ".log"));
+  }
+  const auto total_steps = [&] {
+    std::int64_t n = 0;
+    for (const auto& [pid, h] : heartbeats) n += h.steps_total;
+    return n;
   };
-  wait_heartbeat(2.0);  // warm-up: processes start, the learner starts updating
-  auto first = wait_heartbeat(0.3);
+  const auto pump = [&](double for_s) {
+    const auto end = Clock::now() + std::chrono::duration<double>(for_s);
+    while (Clock::now() < end) monitor->handle(50);
+  };
+  pump(2.0);  // warm-up: processes start, the learner starts updating
+  const std::int64_t first = total_steps();
   std::optional<auvrl_lcm::learner_stats_t> first_stats = stats.take();
   const auto t0 = Clock::now();
-  auto last = wait_heartbeat(seconds);
+  pump(seconds);
   const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
   std::optional<auvrl_lcm::learner_stats_t> last_stats = stats.take();
-  if (!first || !last) {
-    std::printf("training actors=%d error=no_heartbeat\n", actors);
-    return;
-  }
-  const double steps_per_s = static_cast<double>(last->steps_total - first->steps_total) / dt;
+  const double steps_per_s = static_cast<double>(total_steps() - first) / dt;
   const double updates_per_s =
       first_stats && last_stats ? static_cast<double>(last_stats->updates - first_stats->updates) / dt
                                 : 0.0;
-  std::printf("training actors=%d seconds=%.1f env_steps_per_s=%.0f updates_per_s=%.0f "
-              "updates_per_transition=%s\n",
-              actors, dt, steps_per_s, updates_per_s, learner_ratio.c_str());
+  std::printf("training placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
+              "updates_per_s=%.0f updates_per_transition=%s\n",
+              pinned ? "pinned" : "shared", actors, dt, steps_per_s, updates_per_s,
+              learner_ratio.c_str());
   std::fflush(stdout);
 }
 
@@ -85,7 +107,9 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << "\n";
     return 2;
   }
-  run_case(1, seconds, ratio);
-  run_case(2, seconds, ratio);
+  for (bool pinned : {false, true}) {
+    run_case(1, seconds, ratio, pinned);
+    run_case(2, seconds, ratio, pinned);
+  }
   return 0;
 }
