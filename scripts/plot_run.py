@@ -392,13 +392,20 @@ def draw_3d(ax, traj, goal, color, label, reach_t, floor_z=None, arrow_m=0.8):
     if floor_z is not None:  # the horizontal track on the floor of the box
         ax.plot(e, n, np.full_like(d, floor_z), color="0.45", lw=0.9, ls=":",
                 label="horizontal track (on the floor)")
-    if "psi" in traj and len(e) > 1:  # heading every 2 s, while the vehicle moves
+    if "psi" in traj and len(e) > 1:
+        # Heading on the way: up to the reach time (the whole episode if never reached), at
+        # most ~12 arrows, skipping places where the vehicle has hardly moved.
+        t = traj["t"]
+        t_end = reach_t if math.isfinite(reach_t) else t[-1]
+        every = max(2.0, (t_end - t[0]) / 12.0)
         idx, last = [], None
         for i in range(len(e)):
+            if t[i] > t_end + 1e-6:
+                break
             p = np.array([e[i], n[i], d[i]])
             if not np.all(np.isfinite(p)) or not math.isfinite(traj["psi"][i]):
                 continue
-            if last is None or (traj["t"][i] - traj["t"][last] >= 2.0 - 1e-6 and
+            if last is None or (t[i] - t[last] >= every - 1e-6 and
                                 np.linalg.norm(p - [e[last], n[last], d[last]]) > 0.4 * arrow_m):
                 idx.append(i)
                 last = i
@@ -406,7 +413,8 @@ def draw_3d(ax, traj, goal, color, label, reach_t, floor_z=None, arrow_m=0.8):
             psi = traj["psi"][idx]
             ax.quiver(e[idx], n[idx], d[idx], np.sin(psi), np.cos(psi), np.zeros_like(psi),
                       length=arrow_m, color="black", lw=0.9, arrow_length_ratio=0.35,
-                      label="heading (every 2 s while moving)")
+                      label=f"heading (every {every:.0f} s" +
+                      (" until reached)" if math.isfinite(reach_t) else ")"))
     ax.scatter([e[0]], [n[0]], [d[0]], color="tab:green", marker="o", s=45, label="start",
                depthshade=False)
     ax.scatter([e[-1]], [n[-1]], [d[-1]], color=color, marker="s", s=25, label="end (70 s)",
@@ -617,8 +625,8 @@ def plot_suite(ctrls, plots_dir, written):
                             for i, s in enumerate(reasons)], fontsize=8)
         ax.set_ylabel("episodes")
         ax.set_title("outcome (end: the episode's end reason)", fontsize=10)
-        ax.legend(fontsize=7)
-        ax.margins(y=0.15)
+        ax.set_ylim(0, 1.35 * max(len(rows) for _, rows in with_rows))
+        ax.legend(fontsize=7, loc="upper center", ncol=2)
 
         def hist(ax, key, xlabel, title, log=False, reached_only=False):
             vals = []
@@ -855,6 +863,12 @@ def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
             if not drew:
                 no_data(ax, f"no data ({missing} missing)")
             else:
+                if logy == "auto":  # log when the positive values span over 1.5 decades
+                    ys = [np.asarray(ln.get_ydata(), dtype=float) for ln in ax.get_lines()]
+                    ys += [np.asarray(col.get_offsets())[:, 1] for col in ax.collections
+                           if len(col.get_offsets())]
+                    y = finite(np.concatenate(ys)) if ys else np.array([])
+                    logy = bool(y.size) and y.min() > 0 and y.max() > 30 * y.min()
                 if logy:
                     ax.set_yscale("log")
                 if ylim:
@@ -909,17 +923,17 @@ def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
         panel(1, "success rate (goal radius beta reached)",
               [(ep, "ep", ep_success), (pr, "pr", pr_success)], "fraction",
               missing="episodes.csv, progress.csv", ylim=(-0.03, 1.03))
-        panel(2, "distance to way-point at the end", [(ep, "ep", ep_dist)], "m (log)",
-              logy=True, missing="episodes.csv")
+        panel(2, "distance to way-point at the end", [(ep, "ep", ep_dist)], "m",
+              logy="auto", missing="episodes.csv")
         beta_src = [(ep, "ep", beta_of("episodes.csv"))] if ep is not None else \
             [(pr, "pr", beta_of("progress.csv")), (le, "le", beta_of("learner.csv"))][:1]
         if ep is None and pr is None:
             beta_src = [(le, "le", beta_of("learner.csv"))]
-        panel(3, "goal radius beta (curriculum)", beta_src, "m (log)", logy=True,
+        panel(3, "goal radius beta (curriculum)", beta_src, "m", logy="auto",
               missing="episodes.csv, progress.csv, learner.csv")
         panel(4, "critic loss", [(le, "le", learner_col("critic_loss", "tab:red",
                                                           "critic loss", positive=True))],
-              "loss (log)", logy=True, missing="learner.csv")
+              "loss", logy="auto", missing="learner.csv")
         panel(5, "actor loss (-Q of the actor's action)",
               [(le, "le", learner_col("actor_loss", "tab:purple", "actor loss"))], "loss",
               missing="learner.csv")
@@ -1010,8 +1024,9 @@ def training_summary(tr):
     rows = []
     ep, le, pr = tr.ep, tr.learner, tr.progress
     wall = tr.wall_max()
-    rows.append(["wall-clock time", fmt_duration(wall) + (f" ({wall:.0f} s)"
-                                                          if math.isfinite(wall) else "")])
+    rows.append(["wall-clock time", fmt_duration(wall) + (f" ({wall:.0f} s)" if
+                                                          math.isfinite(wall) and wall >= 120
+                                                          else "")])
     if ep is not None:
         n = ep["n"].size
         w = window_for(n)
@@ -1184,7 +1199,7 @@ def write_report(run, ctrls, tr, figures, path):
     L.append("")
     tmp = path + ".tmp"
     with open(tmp, "w", encoding="utf-8") as f:
-        f.write("\n".join(L))
+        f.write("\n".join(L) + "\n")
     os.replace(tmp, path)
 
 

@@ -21,8 +21,7 @@ TEST(TrainingSystem, SimTwoActorsAndLearnerTrainTogether) {
   auto monitor = transport::make_transport({});
   std::map<int, std::vector<auvrl_lcm::episode_report_t>> episodes;
   transport::subscribe<auvrl_lcm::episode_report_t>(
-      *monitor, channels::kEpisode,
-      [&](const std::string&, const auvrl_lcm::episode_report_t& r) {
+      *monitor, channels::kEpisode, [&](const std::string&, const auvrl_lcm::episode_report_t& r) {
         episodes[r.actor_id].push_back(r);
       });
   std::vector<auvrl_lcm::learner_stats_t> stats;
@@ -31,16 +30,16 @@ TEST(TrainingSystem, SimTwoActorsAndLearnerTrainTogether) {
       [&](const std::string&, const auvrl_lcm::learner_stats_t& s) { stats.push_back(s); });
 
   ChildProcess sim({test_support::bin_path("auv_sim"), "--vehicles", "2"}, dir + "/sim.log");
-  ChildProcess learner({test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden",
-                        "32-32", "--batch", "64", "--state-dim", "23", "--replay", "100000",
+  ChildProcess learner({test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden", "32-32",
+                        "--batch", "64", "--state-dim", "23", "--replay", "100000",
                         "--updates-per-transition", "0.25", "--warmup", "500"},
                        dir + "/learner.log");
   std::vector<std::unique_ptr<ChildProcess>> actors;
   for (int id = 0; id < 2; ++id) {
     actors.push_back(std::make_unique<ChildProcess>(
         std::vector<std::string>{test_support::bin_path("auv_actor"), "--actor-id",
-                                 std::to_string(id), "--seed", std::to_string(10 + id),
-                                 "--reward", "shaped", "--max-steps", "100", "--noise",
+                                 std::to_string(id), "--seed", std::to_string(10 + id), "--layout",
+                                 "extended", "--reward", "shaped", "--max-steps", "100", "--noise",
                                  "gaussian"},
         dir + "/actor" + std::to_string(id) + ".log"));
   }
