@@ -87,8 +87,8 @@ struct EpisodeOptions {
   std::vector<TrajectoryRow>* trajectory = nullptr;  ///< recorded when given
 };
 
-/// Runs one episode; returns nothing if the vehicle stopped answering (no transitions after
-/// that point were reported).
+/// Runs one episode. If the vehicle stops answering, the summary ends with kSimTimeout (and
+/// with kBlowUp for a numerical blow-up); no transition after that point is reported.
 EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
                            Controller& controller, const EpisodeOptions& options);
 

@@ -207,7 +207,9 @@ void Reader::expect_magic(const char* magic) {
   if (std::memcmp(got, magic, 8) != 0) {
     std::string printable;
     for (char c : got) printable += (c >= 32 && c < 127) ? c : '?';
-    fail("bad magic: expected '" + std::string(magic, 8) + "', got '" + printable + "'");
+    // The magic ends in a NUL: print it as text up to there, so the message is not cut.
+    fail("bad magic: expected '" + std::string(magic, strnlen(magic, 8)) + "', got '" +
+         printable + "' (not this kind of file, or damaged)");
   }
 }
 
