@@ -25,9 +25,9 @@ struct ActorNodeConfig {
   int vehicle_id = 0;  ///< its vehicle in auv_sim
   task::TaskConfig task;
   ExplorationNoise::Kind noise = ExplorationNoise::Kind::kOrnsteinUhlenbeck;
-  double noise_sigma = 0.2;   ///< OU or Gaussian standard deviation (actions in [-1, 1])
-  double noise_theta = 0.15;  ///< OU mean reversion per step
-  std::uint64_t seed = 1;     ///< way-points and noise; each actor needs its own
+  double noise_sigma = 0.2;     ///< OU or Gaussian standard deviation (actions in [-1, 1])
+  double noise_theta = 0.15;    ///< OU mean reversion per step
+  std::uint64_t seed = 1;       ///< way-points and noise; each actor needs its own
   double initial_beta_m = 1.5;  ///< goal radius until the learner's first weights say otherwise
   int max_transitions_per_message = 256;  ///< keeps an experience message near one datagram
   double weights_request_period_s = 0.5;  ///< while it has no policy, ask this often
@@ -47,7 +47,7 @@ struct ActorCounters {
   std::int64_t batches_sent = 0;
   std::int64_t episodes_discarded = 0;  ///< blow-up or simulator timeout: nothing sent
   std::int64_t weights_applied = 0;
-  std::int64_t weights_rejected = 0;    ///< checksum, format or size mismatch
+  std::int64_t weights_rejected = 0;  ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
   double waited_s = 0.0;  ///< time spent waiting for the learner (flow control)
 };

@@ -93,8 +93,8 @@ int main(int argc, char** argv) {
     signals::install_stop_handlers();
     agent::ActorNode node(config, *transport, std::cerr, lockstep.get());
     std::cerr << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
-              << layout << " state (" << config.task.state_dim() << "), " << reward
-              << " reward, " << noise << " noise, seed " << seed << "\n";
+              << layout << " state (" << config.task.state_dim() << "), " << reward << " reward, "
+              << noise << " noise, seed " << seed << "\n";
     double return_sum = 0.0;
     int successes = 0, window = 0;
     while (!signals::stop_requested() && !node.training_done() &&
@@ -105,8 +105,8 @@ int main(int argc, char** argv) {
       if (++window == report_every) {
         std::cerr << "auv_actor " << config.actor_id << ": episodes " << node.counters().episodes
                   << ", policy v" << node.policy_version() << ", beta " << node.beta_m()
-                  << " m, mean return " << return_sum / window << ", success "
-                  << successes << "/" << window << "\n";
+                  << " m, mean return " << return_sum / window << ", success " << successes << "/"
+                  << window << "\n";
         return_sum = 0.0;
         successes = window = 0;
       }

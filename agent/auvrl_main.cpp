@@ -1,14 +1,13 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
 // library that does the work (agent/evaluation.hpp for eval); adding one is adding a row to
 // kSubcommands.
-#include <exception>
-#include <iostream>
-#include <string>
-
 #include <unistd.h>
 
 #include <cstdlib>
+#include <exception>
 #include <filesystem>
+#include <iostream>
+#include <string>
 #include <vector>
 
 #include "agent/evaluation.hpp"
@@ -74,7 +73,8 @@ int run_train(int argc, const char* const* argv) {
   cli.option("config", &options.config_path, "a configuration file instead of a preset");
   cli.option("run-dir", &options.run_dir, "run directory (default runs/<preset>-<time>)");
   cli.option("resume", &resume_dir, "continue the stopped run in this directory");
-  cli.option("actors", &options.actors, "exploration actors (default: run.actors, 0 = one per CPU)");
+  cli.option("actors", &options.actors,
+             "exploration actors (default: run.actors, 0 = one per CPU)");
   cli.option("max-seconds", &options.max_train_s, "training budget, s (default: run.max_train_s)");
   cli.option("seed", &options.seed, "seed of the run (default: run.seed)");
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
@@ -100,8 +100,9 @@ int run_train(int argc, const char* const* argv) {
   // PID file the run directory keeps (lcm-spy and the log tools join it).
   auvrl::agent::prepare_run_directory(options);
   const std::string netns = std::string(AUVRL_SOURCE_DIR) + "/scripts/netns.sh";
-  std::vector<std::string> args = {netns, "--pidfile", options.run_dir + "/netns.pid",
-                                   own_bin_dir() + "/auvrl", "train", "--resume", options.run_dir};
+  std::vector<std::string> args = {
+      netns,      "--pidfile",    options.run_dir + "/netns.pid", own_bin_dir() + "/auvrl", "train",
+      "--resume", options.run_dir};
   if (options.actors >= 0) args.insert(args.end(), {"--actors", std::to_string(options.actors)});
   if (options.max_train_s >= 0) {
     args.insert(args.end(), {"--max-seconds", std::to_string(options.max_train_s)});

@@ -48,8 +48,8 @@ bool usable(const VehicleReport& r) {
 }
 }  // namespace
 
-EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
-                           Controller& controller, const EpisodeOptions& options) {
+EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
+                           const EpisodeOptions& options) {
   const int n = link.num_thrusters();
   if (n != task.num_thrusters) {
     throw std::invalid_argument("the vehicle has " + std::to_string(n) +
@@ -104,8 +104,9 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
 
     if (!task_ended) {
       if (options.on_transition) {
-        Transition tr{state,          action, outcome.reward, next_state, outcome.terminal,
-                      next->observation.position_ned_m, t - 1};
+        Transition tr{state,      action,           outcome.reward,
+                      next_state, outcome.terminal, next->observation.position_ned_m,
+                      t - 1};
         options.on_transition(tr);
       }
       summary.episode_return += outcome.reward;
@@ -141,8 +142,10 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
       task_ended = true;
     }
   }
-  if (summary.end_reason == task::EndReason::kNone) summary.end_reason = task::EndReason::kTimeLimit;
-  if (steps_after_reach > 0) summary.mean_error_after_reach_m = error_sum_after_reach / steps_after_reach;
+  if (summary.end_reason == task::EndReason::kNone)
+    summary.end_reason = task::EndReason::kTimeLimit;
+  if (steps_after_reach > 0)
+    summary.mean_error_after_reach_m = error_sum_after_reach / steps_after_reach;
   return summary;
 }
 

@@ -60,10 +60,10 @@ struct TrajectoryRow {
 struct EpisodeSummary {
   double episode_return = 0.0;
   int length_steps = 0;
-  bool success = false;             ///< ended inside beta (or, in hold mode, was ever inside)
+  bool success = false;  ///< ended inside beta (or, in hold mode, was ever inside)
   double final_distance_m = 0.0;
   double min_distance_m = 0.0;
-  double thrust_energy = 0.0;       ///< sum of mean squared normalised commands
+  double thrust_energy = 0.0;  ///< sum of mean squared normalised commands
   task::EndReason end_reason = task::EndReason::kNone;
   /// First time inside `reach_radius_m` (see EpisodeOptions), s; negative if never.
   double time_to_reach_s = -1.0;
@@ -89,7 +89,7 @@ struct EpisodeOptions {
 
 /// Runs one episode. If the vehicle stops answering, the summary ends with kSimTimeout (and
 /// with kBlowUp for a numerical blow-up); no transition after that point is reported.
-EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link,
-                           Controller& controller, const EpisodeOptions& options);
+EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
+                           const EpisodeOptions& options);
 
 }  // namespace auvrl::agent

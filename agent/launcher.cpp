@@ -192,6 +192,7 @@ std::string prepare_run_directory(TrainOptions& o) {
 }
 
 int run_training(const TrainOptions& options, std::ostream& out) {
+  out << std::unitbuf;  // progress and supervision lines must reach a log file as they happen
   const fs::path run_dir = options.run_dir;
   const std::string config_path = (run_dir / "config.yaml").string();
   RunConfig rc = read_run_config(config_path);
@@ -301,17 +302,24 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     return "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576";
   };
   for (int i = 0; i < actors; ++i) {
-    const std::string cpu = std::to_string(actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()]);
-    std::vector<std::string> argv = {"/usr/bin/taskset", "-c", cpu, bin + "auv_sim", "--vehicle",
-                                     rc.vehicle_path, "--vehicles", "1", "--first-vehicle-id",
-                                     std::to_string(i)};
-    if (rc.run.private_lockstep_bus) argv.insert(argv.end(), {"--lockstep-lcm-url", lockstep_url(i)});
+    const std::string cpu =
+        std::to_string(actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()]);
+    std::vector<std::string> argv = {
+        "/usr/bin/taskset", "-c",         cpu, bin + "auv_sim",      "--vehicle",
+        rc.vehicle_path,    "--vehicles", "1", "--first-vehicle-id", std::to_string(i)};
+    if (rc.run.private_lockstep_bus)
+      argv.insert(argv.end(), {"--lockstep-lcm-url", lockstep_url(i)});
     sims.push_back(add_role("sim" + std::to_string(i), fixed(argv)));
   }
-  std::vector<std::string> learner_argv = {
-      bin + "auv_learner", "--config", config_path, "--checkpoint-dir",
-      (run_dir / "checkpoints").string(), "--policy-out", (run_dir / "policy.nn").string(),
-      "--max-actors", std::to_string(std::max(actors, 1))};
+  std::vector<std::string> learner_argv = {bin + "auv_learner",
+                                           "--config",
+                                           config_path,
+                                           "--checkpoint-dir",
+                                           (run_dir / "checkpoints").string(),
+                                           "--policy-out",
+                                           (run_dir / "policy.nn").string(),
+                                           "--max-actors",
+                                           std::to_string(std::max(actors, 1))};
   if (rc.run.learner_cpu >= 0 && rc.run.learner_cpu < cpus) {
     learner_argv.insert(learner_argv.begin(),
                         {"/usr/bin/taskset", "-c", std::to_string(rc.run.learner_cpu)});
@@ -324,10 +332,19 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     const std::string url = lockstep_url(i);
     actor_roles.push_back(add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
       // A restarted actor explores anew rather than repeating its first life.
-      std::vector<std::string> argv = {
-          bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
-          "--vehicle-id", std::to_string(i), "--seed", std::to_string(seed + 7919 * restarts),
-          "--pin-cpu", std::to_string(cpu), "--report-every", "100"};
+      std::vector<std::string> argv = {bin + "auv_actor",
+                                       "--config",
+                                       config_path,
+                                       "--actor-id",
+                                       std::to_string(i),
+                                       "--vehicle-id",
+                                       std::to_string(i),
+                                       "--seed",
+                                       std::to_string(seed + 7919 * restarts),
+                                       "--pin-cpu",
+                                       std::to_string(cpu),
+                                       "--report-every",
+                                       "100"};
       if (private_bus) argv.insert(argv.end(), {"--lockstep-lcm-url", url});
       return argv;
     }));
@@ -336,6 +353,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     std::vector<std::string> argv = r.argv(r.restarts.size());
     if (&r == learner && resume_learner) argv.push_back("--resume");
     r.proc = std::make_unique<process::ChildProcess>(argv, r.log_path, true);
+    // PID in the run's namespace, for tools and tests started in that namespace.
+    std::ofstream((proc_dir / (r.name + ".pid")).string()) << r.proc->pid() << "\n";
   };
   start_role(*logger, false);
   for (Role* s : sims) start_role(*s, false);
@@ -347,8 +366,9 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   // ---- Supervise, show progress, keep the best policy. ----
   const bool tty = isatty(STDOUT_FILENO) != 0;
   auto next_progress = Clock::now();
-  auto next_best_eval = Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                           std::chrono::duration<double>(rc.run.best_eval_period_s));
+  auto next_best_eval =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                         std::chrono::duration<double>(rc.run.best_eval_period_s));
   QuickScore best;
   std::int64_t best_version = -1;
   std::string stop_reason;
@@ -449,8 +469,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
       const std::string best_text =
           best_version < 0 ? "-"
                            : std::to_string(best.reached) + "/" + std::to_string(best.episodes);
-      progress_csv << std::fixed << std::setprecision(1) << wall() << ',' << learner_episodes
-                   << ',' << std::setprecision(3) << success_rate << ',' << beta_m << ','
+      progress_csv << std::fixed << std::setprecision(1) << wall() << ',' << learner_episodes << ','
+                   << std::setprecision(3) << success_rate << ',' << beta_m << ','
                    << std::setprecision(0) << steps_per_s << ',' << updates_per_s << ','
                    << (best_version < 0 ? 0.0 : static_cast<double>(best.reached) / best.episodes)
                    << '\n';
@@ -461,8 +481,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
       line << std::fixed << "episodes " << learner_episodes << "  success(100) "
            << std::setprecision(0) << 100 * success_rate << "%  beta " << std::setprecision(2)
            << beta_m << " m  env " << std::setprecision(0) << steps_per_s << " steps/s  updates "
-           << updates_per_s << "/s  best " << best_text << "  elapsed "
-           << format_duration(wall()) << "  left " << format_duration(eta);
+           << updates_per_s << "/s  best " << best_text << "  elapsed " << format_duration(wall())
+           << "  left " << format_duration(eta);
       if (tty) {
         out << "\r" << line.str() << "   " << std::flush;
       } else if (wall() - last_print_s >= 5.0) {
@@ -493,9 +513,9 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   out << "auvrl train: run directory " << run_dir.string() << "\n"
       << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
       << "  policy       " << (run_dir / "policy.nn").string()
-      << (best_version >= 0 ? "  (best so far: policy_best.nn, version " +
-                                  std::to_string(best_version) + ")"
-                            : "")
+      << (best_version >= 0
+              ? "  (best so far: policy_best.nn, version " + std::to_string(best_version) + ")"
+              : "")
       << "\n  logs         " << (run_dir / "logs").string() << "\n";
   if (exit_code != 0) {
     out << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
@@ -544,8 +564,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   }
   out << "\nlearned policy (" << policy_path << "):\n"
       << format_summary_table(policy_rows) << "\nPID baseline:\n"
-      << format_summary_table(pid_rows) << "\nreport: " << (run_dir / "report.md").string()
-      << "\n";
+      << format_summary_table(pid_rows) << "\nreport: " << (run_dir / "report.md").string() << "\n";
   return 0;
 }
 

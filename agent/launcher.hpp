@@ -14,9 +14,9 @@ namespace auvrl::agent {
 
 /// The `run:` section of a run configuration.
 struct RunSettings {
-  int actors = 0;               ///< 0: one per CPU
-  std::uint64_t seed = 1;       ///< actor i uses seed * 1000 + i (+ a restart offset)
-  double max_train_s = 0.0;     ///< wall-clock training budget, s (0: until the learner ends)
+  int actors = 0;                    ///< 0: one per CPU
+  std::uint64_t seed = 1;            ///< actor i uses seed * 1000 + i (+ a restart offset)
+  double max_train_s = 0.0;          ///< wall-clock training budget, s (0: until the learner ends)
   double best_eval_period_s = 10.0;  ///< quick evaluation of the newest weights, s
   int best_eval_suite = 20;          ///< way-points in that quick evaluation
   /// CPU the learner is pinned to (-1: not pinned); actors then use the other CPUs.
@@ -24,21 +24,21 @@ struct RunSettings {
   /// Each simulator and its actor talk on a bus of their own (port 7668 + i), so nobody else
   /// receives their ~2 x 20k messages/s; false puts everything on the system's bus.
   bool private_lockstep_bus = true;
-  int max_restarts = 5;         ///< a role restarted more often than this within...
+  int max_restarts = 5;             ///< a role restarted more often than this within...
   double restart_window_s = 120.0;  ///< ...this many seconds stops the run
 };
 
 /// What `auvrl train` was asked.
 struct TrainOptions {
-  std::string config_path;   ///< a preset or configuration file (new runs)
-  std::string run_dir;       ///< the run directory (created for new runs)
-  bool resume = false;       ///< continue the run in run_dir
-  int actors = -1;           ///< overrides run.actors when >= 0
-  double max_train_s = -1;   ///< overrides run.max_train_s when >= 0
-  std::int64_t seed = -1;    ///< overrides run.seed when >= 0
-  bool evaluate = true;      ///< evaluation, plots and report after training
-  std::string bin_dir;       ///< where auv_sim, auv_actor, auv_learner, auv_logger are
-  std::string source_dir;    ///< the source tree (scripts/ for plots)
+  std::string config_path;  ///< a preset or configuration file (new runs)
+  std::string run_dir;      ///< the run directory (created for new runs)
+  bool resume = false;      ///< continue the run in run_dir
+  int actors = -1;          ///< overrides run.actors when >= 0
+  double max_train_s = -1;  ///< overrides run.max_train_s when >= 0
+  std::int64_t seed = -1;   ///< overrides run.seed when >= 0
+  bool evaluate = true;     ///< evaluation, plots and report after training
+  std::string bin_dir;      ///< where auv_sim, auv_actor, auv_learner, auv_logger are
+  std::string source_dir;   ///< the source tree (scripts/ for plots)
 };
 
 /// Creates the run directory of a new run (config copy, folders) or checks an existing one for

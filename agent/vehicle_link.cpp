@@ -14,11 +14,12 @@ class InProcessLink final : public VehicleLink {
   std::optional<VehicleReport> reset(const EpisodeStart& start) override {
     sim::ResetSettings settings;
     settings.eta << start.position_ned_m, start.euler_rpy_rad;
-    settings.thruster_efficiency = start.thruster_efficiency.empty()
-                                       ? sim::ThrusterVector::Ones(model_.num_thrusters())
-                                       : sim::ThrusterVector(Eigen::Map<const Eigen::VectorXd>(
-                                             start.thruster_efficiency.data(),
-                                             static_cast<Eigen::Index>(start.thruster_efficiency.size())));
+    settings.thruster_efficiency =
+        start.thruster_efficiency.empty()
+            ? sim::ThrusterVector::Ones(model_.num_thrusters())
+            : sim::ThrusterVector(Eigen::Map<const Eigen::VectorXd>(
+                  start.thruster_efficiency.data(),
+                  static_cast<Eigen::Index>(start.thruster_efficiency.size())));
     settings.current.constant_velocity_ned_mps = start.current_ned_mps;
     settings.seed = start.seed;
     state_ = sim::make_state(model_, settings);
@@ -28,7 +29,7 @@ class InProcessLink final : public VehicleLink {
   std::optional<VehicleReport> step(const std::vector<double>& thrust_n) override {
     if (!state_) return std::nullopt;
     command_ = Eigen::Map<const Eigen::VectorXd>(thrust_n.data(),
-                                                  static_cast<Eigen::Index>(thrust_n.size()));
+                                                 static_cast<Eigen::Index>(thrust_n.size()));
     sim::step(model_, *state_, command_);
     return report();
   }

@@ -18,8 +18,8 @@ namespace auvrl::agent {
 struct VehicleReport {
   task::Observation observation;
   std::vector<double> thrust_realised_n;  ///< per thruster, N
-  double time_s = 0.0;                     ///< since the reset, s
-  bool blown_up = false;                   ///< the simulator flagged a numerical blow-up
+  double time_s = 0.0;                    ///< since the reset, s
+  bool blown_up = false;                  ///< the simulator flagged a numerical blow-up
 };
 
 /// Initial conditions and faults of an episode.

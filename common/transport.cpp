@@ -57,8 +57,8 @@ class LcmTransport final : public Transport {
                            int queue_capacity) override {
     auto sub = std::make_unique<Subscription>();
     sub->handler = std::move(handler);
-    sub->lcm_subscription = lcm_subscribe(lcm_, channel_regex.c_str(), &LcmTransport::dispatch,
-                                          sub.get());
+    sub->lcm_subscription =
+        lcm_subscribe(lcm_, channel_regex.c_str(), &LcmTransport::dispatch, sub.get());
     if (sub->lcm_subscription == nullptr) {
       throw TransportError("LCM cannot subscribe to '" + channel_regex + "'");
     }

@@ -17,7 +17,8 @@ namespace auvrl::transport {
 /// Default LCM URL: multicast that never leaves the host (ttl=0) with a receive buffer sized
 /// for the largest message (policy weights of a 400-300 actor are ~0.5 MB; the kernel caps
 /// the request at net.core.rmem_max and doubles it).
-inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
+inline constexpr const char* kDefaultLcmUrl =
+    "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
 
 /// Which transport to open and how.
 struct TransportConfig {

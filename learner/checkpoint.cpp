@@ -44,7 +44,8 @@ std::string write_checkpoint(const std::string& dir, std::int64_t updates, int k
                              const std::function<void(nn::Writer&)>& fill) {
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create checkpoint directory " + dir + ": " + ec.message());
+  if (ec)
+    throw std::runtime_error("cannot create checkpoint directory " + dir + ": " + ec.message());
   char name[64];
   std::snprintf(name, sizeof name, "%s%012lld%s", kPrefix, static_cast<long long>(updates),
                 kSuffix);

@@ -30,8 +30,9 @@ std::string write_checkpoint(const std::string& dir, std::int64_t updates, int k
 
 /// Tries the checkpoints in dir from the newest: calls `restore` on each until one succeeds.
 /// restore must read the whole record into temporaries, call Reader::verify_checksum(), and
-/// only then commit, so that a damaged file (it throws std::runtime_error) changes nothing. Reports every damaged file on `log`. Returns the one restored; throws
-/// std::runtime_error if none could be (or there is none).
+/// only then commit, so that a damaged file (it throws std::runtime_error) changes nothing. Reports
+/// every damaged file on `log`. Returns the one restored; throws std::runtime_error if none could
+/// be (or there is none).
 CheckpointFile restore_latest_checkpoint(const std::string& dir,
                                          const std::function<void(nn::Reader&)>& restore,
                                          std::ostream& log);

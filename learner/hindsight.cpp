@@ -47,8 +47,8 @@ void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::
     const std::size_t future =
         step + static_cast<std::size_t>(nn::uniform_index(rng, slots.size() - step));
     const std::int64_t future_slot = slots[future];
-    if (future_slot < 0 || replay.episode_id(static_cast<std::size_t>(future_slot)) !=
-                               replay.episode_id(slot)) {
+    if (future_slot < 0 ||
+        replay.episode_id(static_cast<std::size_t>(future_slot)) != replay.episode_id(slot)) {
       continue;
     }
     const Eigen::Vector3d old_goal = replay.goal_ned_m(slot).cast<double>();
@@ -64,10 +64,10 @@ void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::
     // A failure that did not depend on the goal (a flip) stays one: terminal with the failure
     // reward while still inside beta_max of the original goal.
     const double old_distance = (old_goal - achieved).norm();
-    const bool failed = batch.terminal(0, i) > 0.5f &&
-                        std::abs(batch.reward(0, i) - static_cast<float>(task_.failure_reward)) <
-                            1e-4f &&
-                        task_.failure_reward != task_.goal_reward;
+    const bool failed =
+        batch.terminal(0, i) > 0.5f &&
+        std::abs(batch.reward(0, i) - static_cast<float>(task_.failure_reward)) < 1e-4f &&
+        task_.failure_reward != task_.goal_reward;
     const bool flipped = failed && old_distance <= task_.beta_max_m;
 
     task::relabel_state(task_, old_goal, new_goal, state);

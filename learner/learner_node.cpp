@@ -3,9 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
-
 #include <auvrl_lcm/policy_summary_t.hpp>
+#include <cmath>
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
@@ -42,7 +41,8 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
       transport_(transport),
       log_(log),
       sample_rng_(config_.ddpg.seed ^ 0x5851F42D4C957F2Dull),
-      batch_(config_.ddpg.state_dim, config_.ddpg.action_dim, std::max(1, config_.ddpg.batch_size)) {
+      batch_(config_.ddpg.state_dim, config_.ddpg.action_dim,
+             std::max(1, config_.ddpg.batch_size)) {
   config_.ddpg.validate();
   if (config_.updates_per_transition < 0 || !std::isfinite(config_.updates_per_transition)) {
     throw std::invalid_argument("updates_per_transition must be finite and >= 0");
@@ -57,10 +57,9 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
   if (config_.her) {
     if (config_.task.state_dim() != config_.ddpg.state_dim ||
         config_.task.num_thrusters != config_.ddpg.action_dim) {
-      throw std::invalid_argument("her: the task's state/action sizes (" +
-                                  std::to_string(config_.task.state_dim()) + ", " +
-                                  std::to_string(config_.task.num_thrusters) +
-                                  ") differ from the learner's");
+      throw std::invalid_argument(
+          "her: the task's state/action sizes (" + std::to_string(config_.task.state_dim()) + ", " +
+          std::to_string(config_.task.num_thrusters) + ") differ from the learner's");
     }
     her_ = std::make_unique<HindsightRelabeler>(config_.task, config_.her_k);
   }
@@ -73,9 +72,7 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
       &decode_stats_, 10000));
   subscriptions_.push_back(subscribe<auvrl_lcm::weights_request_t>(
       transport_, channels::kWeightsRequest,
-      [this](const std::string&, const auvrl_lcm::weights_request_t& m) {
-        on_weights_request(m);
-      },
+      [this](const std::string&, const auvrl_lcm::weights_request_t& m) { on_weights_request(m); },
       &decode_stats_));
   subscriptions_.push_back(subscribe<auvrl_lcm::episode_report_t>(
       transport_, channels::kEpisode,
@@ -123,11 +120,10 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
     ++counters_.dropped_dims;
     return;
   }
-  const bool finite = all_finite(msg.states) && all_finite(msg.next_states) &&
-                      all_finite(msg.actions) && all_finite(msg.achieved_position_ned_m) &&
-                      all_finite(msg.goal_ned_m) &&
-                      std::all_of(msg.rewards.begin(), msg.rewards.end(),
-                                  [](float r) { return std::isfinite(r); });
+  const bool finite =
+      all_finite(msg.states) && all_finite(msg.next_states) && all_finite(msg.actions) &&
+      all_finite(msg.achieved_position_ned_m) && all_finite(msg.goal_ned_m) &&
+      std::all_of(msg.rewards.begin(), msg.rewards.end(), [](float r) { return std::isfinite(r); });
   // Actions come out of tanh: anything beyond [-1, 1] did not come from a policy.
   const bool actions_in_range = std::all_of(msg.actions.begin(), msg.actions.end(), [](auto& a) {
     return std::all_of(a.begin(), a.end(), [](float v) { return std::abs(v) <= 1.0f + 1e-6f; });
@@ -150,12 +146,9 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
     const auto& pos = msg.achieved_position_ned_m[static_cast<std::size_t>(i)];
     const auto& goal = msg.goal_ned_m[static_cast<std::size_t>(i)];
     const TransitionView t{
-        Vec(msg.states[i].data(), msg.state_dim),
-        Vec(msg.actions[i].data(), msg.action_dim),
-        msg.rewards[static_cast<std::size_t>(i)],
-        Vec(msg.next_states[i].data(), msg.state_dim),
-        msg.terminal[static_cast<std::size_t>(i)] != 0,
-        Eigen::Vector3f(pos[0], pos[1], pos[2]),
+        Vec(msg.states[i].data(), msg.state_dim), Vec(msg.actions[i].data(), msg.action_dim),
+        msg.rewards[static_cast<std::size_t>(i)], Vec(msg.next_states[i].data(), msg.state_dim),
+        msg.terminal[static_cast<std::size_t>(i)] != 0, Eigen::Vector3f(pos[0], pos[1], pos[2]),
         Eigen::Vector3f(goal[0], goal[1], goal[2]),
         // Episode ids are per actor: the actor id in the top bits makes them global.
         (static_cast<std::uint64_t>(msg.actor_id) << 40) |
@@ -193,8 +186,8 @@ void LearnerNode::run_updates() {
   const auto threshold = static_cast<std::size_t>(
       std::max<std::int64_t>(config_.ddpg.batch_size, config_.warmup_transitions));
   int done = 0;
-  while (update_credit_ >= 1.0 && replay_->size() > threshold && done < config_.max_updates_per_poll &&
-         !training_done()) {
+  while (update_credit_ >= 1.0 && replay_->size() > threshold &&
+         done < config_.max_updates_per_poll && !training_done()) {
     UpdateStats stats;
     if (her_) {
       replay_->sample(sample_rng_, config_.ddpg.batch_size, batch_);
@@ -216,8 +209,7 @@ void LearnerNode::run_updates() {
 void LearnerNode::maybe_publish_weights() {
   const std::int64_t updates = ddpg_->updates();
   const bool due_by_count = updates - last_broadcast_updates_ >= config_.broadcast_every_updates;
-  const bool rate_ok =
-      Clock::now() - last_broadcast_ >= seconds(config_.broadcast_min_interval_s);
+  const bool rate_ok = Clock::now() - last_broadcast_ >= seconds(config_.broadcast_min_interval_s);
   if (broadcast_requested_ || (due_by_count && rate_ok)) publish_weights();
 }
 
@@ -282,8 +274,8 @@ void LearnerNode::publish_stats() {
   s.dropped_dims = counters_.dropped_dims;
   s.dropped_non_finite = counters_.dropped_non_finite;
   s.dropped_unknown_actor = counters_.dropped_unknown_actor;
-  s.batches_dropped = s.dropped_dims + s.dropped_non_finite + s.dropped_unknown_actor +
-                      decode_stats_.failed;
+  s.batches_dropped =
+      s.dropped_dims + s.dropped_non_finite + s.dropped_unknown_actor + decode_stats_.failed;
   s.batches_lost = counters_.batches_lost;
   s.checkpoints_written = counters_.checkpoints_written;
   transport::publish(transport_, channels::kLearnerStats, s);

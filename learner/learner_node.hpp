@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "common/task/goal_schedule.hpp"
-#include "common/transport.hpp"
 #include "common/task/task.hpp"
+#include "common/transport.hpp"
 #include "learner/ddpg.hpp"
 #include "learner/hindsight.hpp"
 #include "learner/replay_buffer.hpp"
@@ -44,23 +44,23 @@ struct LearnerNodeConfig {
   /// ...but at most once per this interval (0: no limit), s.
   double broadcast_min_interval_s = 0.05;
 
-  int max_actors = 64;                 ///< accepted actor ids: 0 .. max_actors - 1
+  int max_actors = 64;  ///< accepted actor ids: 0 .. max_actors - 1
   int max_transitions_per_batch = 10000;
   double stats_period_s = 1.0;
 
-  task::GoalSchedule schedule;         ///< beta from the episode count
+  task::GoalSchedule schedule;  ///< beta from the episode count
   /// Hindsight relabelling ("future" strategy) of sampled minibatches with the task's reward;
   /// needs `task` to be the actors' task configuration.
   bool her = false;
   int her_k = 4;  ///< future goals per real one
   task::TaskConfig task;
-  std::int64_t max_episodes = 0;       ///< training ends after this many episodes (0: never)
-  std::int64_t max_updates = 0;        ///< or after this many updates (0: never)
+  std::int64_t max_episodes = 0;  ///< training ends after this many episodes (0: never)
+  std::int64_t max_updates = 0;   ///< or after this many updates (0: never)
 
-  std::string checkpoint_dir;          ///< empty: no checkpoints
+  std::string checkpoint_dir;  ///< empty: no checkpoints
   double checkpoint_period_s = 300.0;
   int keep_checkpoints = 2;
-  std::string policy_path;             ///< where finish() writes the actor network (optional)
+  std::string policy_path;  ///< where finish() writes the actor network (optional)
 };
 
 /// Counters of what arrived and what was done with it.

@@ -115,6 +115,15 @@ def parse_str(s):
     return s.strip()
 
 
+def short(text, n=24):
+    """A cell or column name for a message: printable ASCII, at most n characters."""
+    text = ascii(str(text))[1:-1]
+    return text if len(text) <= n else text[:n] + "..."
+
+
+MAX_ROW_NOTES = 5  # damaged rows listed per file; the rest are counted
+
+
 def read_csv(path, spec, label=None, required=()):
     """Rows of a CSV as dicts, parsed per spec {column: parser}; None when the file is missing
     or unusable. Columns not in spec are parsed as floats. Columns of spec absent from the
@@ -124,6 +133,14 @@ def read_csv(path, spec, label=None, required=()):
     if not os.path.isfile(path):
         return None
     rows = []
+    bad = 0
+
+    def damaged(text):
+        nonlocal bad
+        bad += 1
+        if bad <= MAX_ROW_NOTES:
+            NOTES.damage(text)
+
     try:
         with open(path, newline="", encoding="utf-8", errors="replace") as f:
             reader = csv.reader(f)
@@ -144,8 +161,8 @@ def read_csv(path, spec, label=None, required=()):
                     continue
                 line = reader.line_num
                 if len(fields) != len(header):
-                    NOTES.damage(f"{label}:{line}: {len(fields)} fields, expected "
-                                 f"{len(header)}; row skipped")
+                    damaged(f"{label}:{line}: {len(fields)} fields, expected {len(header)}; "
+                            "row skipped")
                     continue
                 row = {}
                 try:
@@ -153,15 +170,19 @@ def read_csv(path, spec, label=None, required=()):
                         try:
                             row[name] = parse(cell)
                         except ValueError:
-                            raise ValueError(f"column {name}: cannot read {cell.strip()!r}")
+                            raise ValueError(f"column {short(name)}: cannot read "
+                                             f"'{short(cell.strip())}'")
                 except ValueError as e:
-                    NOTES.damage(f"{label}:{line}: {e}; row skipped")
+                    damaged(f"{label}:{line}: {e}; row skipped")
                     continue
                 for c in absent:
                     row[c] = None if spec[c] in (parse_str, parse_end_reason) else math.nan
                 rows.append(row)
     except (OSError, csv.Error) as e:
         NOTES.damage(f"{label}: cannot read ({e}); what was read is used")
+    if bad > MAX_ROW_NOTES:
+        NOTES.damage(f"{label}: {bad - MAX_ROW_NOTES} more damaged rows skipped "
+                     f"({bad} in all, {len(rows)} rows read)")
     if header is None:
         NOTES.damage(f"{label}: empty file")
         return None
@@ -212,7 +233,8 @@ class Controller:
         self.label = CONTROLLER_LABEL.get(name, name)
         self.color = CONTROLLER_COLOR.get(name)
         if self.summary is None:
-            NOTES.miss(f"{rel} (no summary table for {self.label})")
+            if not os.path.isfile(os.path.join(directory, "summary.csv")):
+                NOTES.miss(f"{rel} (no summary table for {self.label})")
             self.summary = []
         self._traj = {}
 
@@ -231,7 +253,8 @@ class Controller:
         if key not in self._traj:
             path = os.path.join(self.dir, "trajectories", f"{scenario}_{episode}.csv")
             rel = os.path.relpath(path, self.run)
-            rows = read_csv(path, {}, rel, required=())
+            rows = read_csv(path, {c: parse_float for c in TRAJ_REQUIRED}, rel,
+                            required=TRAJ_REQUIRED)
             data = None
             if rows:
                 names = list(rows[0].keys())
@@ -463,9 +486,11 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
     ncol = len(panels)
     names = []
     title = SCENARIO_TEXT.get(scenario, scenario)
+    sep = ": " if ncol > 1 else "\n"  # one column: the title on two lines
+    extra = 0.0 if ncol > 1 else 0.22  # inches for the second title line
 
     # --- 3-D trajectory (paper Fig. 3, 6, 7). ---
-    fig = plt.figure(figsize=(6.2 * ncol, 6.0))
+    fig = plt.figure(figsize=(max(7.5, 6.2 * ncol), 6.0 + extra))
     pts = []
     for c, ep, traj, goal, t_reach, src in panels:
         pts += list(np.column_stack([traj["y"], traj["x"], traj["z"]]))
@@ -479,12 +504,14 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
         ax.view_init(elev=22, azim=-60)
         ax.set_title(f"{c.label}\n{reach_text(t_reach, src)}", fontsize=10)
         ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
-    fig.suptitle(f"{title}: 3-D path (NED, depth down)", fontsize=11)
-    fig.subplots_adjust(left=0.0, right=0.97, bottom=0.03, top=0.86, wspace=0.08)
+    fig.suptitle(f"{title}{sep}3-D path (NED, depth down)", fontsize=11)
+    fig.subplots_adjust(left=0.0, right=0.97, bottom=0.03,
+                        top=1 - (0.84 + extra) / fig.get_figheight(), wspace=0.08)
     names.append(save(fig, plots_dir, f"eval_{scenario}_3d.png", written))
 
     # --- Position against time (paper Fig. 4a, 5a, 8a) and distance to the way-point. ---
-    fig, axes = plt.subplots(2, ncol, figsize=(6.0 * ncol, 6.6), squeeze=False,
+    fig, axes = plt.subplots(2, ncol, figsize=(max(7.5, 6.0 * ncol), 6.6 + extra),
+                             squeeze=False,
                              sharex=True, sharey="row", gridspec_kw={"height_ratios": [3, 2]})
     axis_colors = {"x": "tab:blue", "y": "tab:green", "z": "tab:red"}
     axis_names = {"x": "x (north)", "y": "y (east)", "z": "z (depth, down +)"}
@@ -514,9 +541,9 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
         ax.set_xlabel("t [s]")
         if k == 0:
             ax.set_ylabel("distance [m] (log)")
-    fig.suptitle(f"{title}: position against time", fontsize=11)
-    fig.subplots_adjust(left=0.07 if ncol > 1 else 0.12, right=0.98, bottom=0.08, top=0.9,
-                        hspace=0.12, wspace=0.05)
+    fig.suptitle(f"{title}{sep}position against time", fontsize=11)
+    fig.subplots_adjust(left=0.07 if ncol > 1 else 0.1, right=0.98, bottom=0.08,
+                        top=1 - (0.66 + extra) / fig.get_figheight(), hspace=0.12, wspace=0.05)
     names.append(save(fig, plots_dir, f"eval_{scenario}_position.png", written))
 
     # --- The six thrusters (paper Fig. 4b, 5b, 8b): realised thrust, command faint. ---
@@ -524,7 +551,8 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
     if nthr == 0:
         NOTES.damage(f"{scenario}: trajectories have no thrust_i columns; no thruster plot")
         return names
-    fig, axes = plt.subplots(nthr, ncol, figsize=(6.0 * ncol, 1.35 * nthr + 1.2),
+    fig, axes = plt.subplots(nthr, ncol, figsize=(max(8.0, 6.0 * ncol),
+                                                  1.35 * nthr + 1.2 + extra),
                              squeeze=False, sharex=True, sharey=True)
     for k, (c, ep, traj, goal, t_reach, src) in enumerate(panels):
         for i in range(nthr):
@@ -560,11 +588,11 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
                 matplotlib.lines.Line2D([], [], color="black", lw=1.0, ls=":",
                                         label=f"within {REACH_M} m")]
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8,
-               bbox_to_anchor=(0.5, 0.965), frameon=False)
-    fig.suptitle(f"{title}: thruster outputs (realised: after delay, lag, slew and "
+               bbox_to_anchor=(0.5, 1 - (0.32 + extra) / fig.get_figheight()), frameon=False)
+    fig.suptitle(f"{title}{sep}thruster outputs (realised: after delay, lag, slew and "
                  "efficiency)", fontsize=10.5)
-    top = 1 - 0.85 / fig.get_figheight()
-    fig.subplots_adjust(left=0.08 if ncol > 1 else 0.13, right=0.98, bottom=0.06, top=top,
+    top = 1 - (0.85 + extra) / fig.get_figheight()
+    fig.subplots_adjust(left=0.08 if ncol > 1 else 0.12, right=0.98, bottom=0.06, top=top,
                         hspace=0.15, wspace=0.05)
     names.append(save(fig, plots_dir, f"eval_{scenario}_thrusters.png", written))
     return names
@@ -578,7 +606,8 @@ def plot_distance_overview(ctrls, plots_dir, written):
     have = [(c, st) for c, st in have if st]
     if not have:
         return None
-    fig, axes = plt.subplots(1, len(have), figsize=(6.0 * len(have), 4.0), squeeze=False,
+    fig, axes = plt.subplots(1, len(have), figsize=(max(7.0, 6.0 * len(have)), 4.0),
+                             squeeze=False,
                              sharey=True)
     colors = {"test1": "tab:blue", "test2": "tab:green", "fault": "tab:red",
               "current": "tab:purple"}
@@ -710,7 +739,7 @@ def plot_suite(ctrls, plots_dir, written):
     saved = [(c, c.trajectory_episodes(SUITE)) for c in ctrls]
     saved = [(c, eps) for c, eps in saved if eps]
     if saved:
-        fig = plt.figure(figsize=(6.2 * len(saved), 6.0))
+        fig = plt.figure(figsize=(max(7.5, 6.2 * len(saved)), 6.0))
         pts, draw = [], []
         for c, eps in saved:
             items = []
@@ -1058,16 +1087,20 @@ def training_summary(tr):
             rows.append(["episodes (progress.csv)", f"{np.nanmax(pr['episodes']):.0f}"])
     if le is not None:
         last = {k: v[-1] for k, v in le.items()}
+
+        def g(key, spec=".0f"):
+            v = last[key]
+            return format(v, spec) if math.isfinite(v) else "-"
         ups = finite(le["updates_per_s"])
         ups = ups[ups > 0]
-        rows.append(["learner updates", f"{last['updates']:.0f}" + (
+        rows.append(["learner updates", g("updates") + (
             f" (mean {ups.mean():.0f} updates/s while updating)" if ups.size else "")])
         rows.append(["transitions received / replay buffer",
-                     f"{last['transitions_received']:.0f} / {last['buffer_size']:.0f}"])
+                     f"{g('transitions_received')} / {g('buffer_size')}"])
         rows.append(["last critic loss / actor loss / mean Q",
-                     f"{last['critic_loss']:.4g} / {last['actor_loss']:.4g} / "
-                     f"{last['mean_q']:.4g}"])
-        rows.append(["policy weights published", f"{last['weights_published']:.0f}"])
+                     f"{g('critic_loss', '.4g')} / {g('actor_loss', '.4g')} / "
+                     f"{g('mean_q', '.4g')}"])
+        rows.append(["policy weights published", g("weights_published")])
     return rows
 
 

@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
     }
     signals::install_stop_handlers();
     sim::SimServer sim_server(model, lockstep ? *lockstep : *transport, server, transport.get());
-    std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " ("
-              << vehicle_path << "), " << (realtime ? "real time" : "lockstep") << ", "
+    std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " (" << vehicle_path
+              << "), " << (realtime ? "real time" : "lockstep") << ", "
               << (lockstep_url.empty() ? transport_config.lcm_url : lockstep_url) << "\n";
     sim_server.run([] { return signals::stop_requested(); });
     const auto counters = sim_server.counters();

@@ -27,10 +27,14 @@ Vector6 pose_vector(const double position[3], const double euler[3]) {
 
 std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, int num_thrusters,
                                         ResetSettings& out) {
-  const double scalars[] = {msg.current_gm_mean_speed_mps,  msg.current_gm_sigma_mps,
-                            msg.current_gm_time_constant_s, msg.current_gm_direction_rad,
-                            msg.current_gm_direction_sigma_rad, msg.noise_position_m,
-                            msg.noise_attitude_rad,           msg.noise_velocity_mps,
+  const double scalars[] = {msg.current_gm_mean_speed_mps,
+                            msg.current_gm_sigma_mps,
+                            msg.current_gm_time_constant_s,
+                            msg.current_gm_direction_rad,
+                            msg.current_gm_direction_sigma_rad,
+                            msg.noise_position_m,
+                            msg.noise_attitude_rad,
+                            msg.noise_velocity_mps,
                             msg.noise_angular_rate_rad_s};
   if (!all_finite(msg.position_ned_m, 3) || !all_finite(msg.euler_rpy_rad, 3) ||
       !all_finite(msg.velocity_body_mps, 3) || !all_finite(msg.angular_rate_body_rad_s, 3) ||
@@ -66,8 +70,7 @@ std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, i
     out.thruster_efficiency =
         Eigen::Map<const Eigen::VectorXd>(msg.thruster_efficiency.data(), num_thrusters);
   }
-  out.current.constant_velocity_ned_mps =
-      Eigen::Map<const Vector3>(msg.current_constant_ned_mps);
+  out.current.constant_velocity_ned_mps = Eigen::Map<const Vector3>(msg.current_constant_ned_mps);
   out.current.gauss_markov_speed_mean_mps = msg.current_gm_mean_speed_mps;
   out.current.gauss_markov_speed_sigma_mps = msg.current_gm_sigma_mps;
   if (msg.current_gm_time_constant_s > 0) {
@@ -292,8 +295,8 @@ void SimServer::realtime_tick() {
 }
 
 int SimServer::next_realtime_wait_ms() const {
-  const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(next_realtime_step_ -
-                                                                           Clock::now());
+  const auto wait =
+      std::chrono::duration_cast<std::chrono::milliseconds>(next_realtime_step_ - Clock::now());
   return static_cast<int>(std::clamp<std::int64_t>(wait.count(), 0, 50));
 }
 

@@ -21,7 +21,8 @@ std::string Section::key_path(const std::string& key) const {
 void Section::fail(const std::string& key, const std::string& what) const {
   std::string where;
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node();
-  if (n.IsDefined() && n.Mark().line >= 0) where = " (line " + std::to_string(n.Mark().line + 1) + ")";
+  if (n.IsDefined() && n.Mark().line >= 0)
+    where = " (line " + std::to_string(n.Mark().line + 1) + ")";
   throw ConfigError(file_ + ": '" + key_path(key) + "': " + what + where);
 }
 
@@ -52,8 +53,8 @@ std::int64_t Section::integer(const YAML::Node& node, const std::string& key) co
     if (!node.IsScalar()) throw YAML::Exception(YAML::Mark::null_mark(), "");
     return node.as<std::int64_t>();
   } catch (const YAML::Exception&) {
-    fail(key, "expected an integer, got '" + (node.IsScalar() ? node.Scalar() : "a list or map") +
-                  "'");
+    fail(key,
+         "expected an integer, got '" + (node.IsScalar() ? node.Scalar() : "a list or map") + "'");
   }
 }
 

@@ -50,8 +50,8 @@ double GoalSchedule::beta_m(std::int64_t episodes) const {
     const ScheduleKnot& a = knots_[i - 1];
     const ScheduleKnot& b = knots_[i];
     if (episodes >= b.episode) continue;
-    const double s = static_cast<double>(episodes - a.episode) /
-                     static_cast<double>(b.episode - a.episode);
+    const double s =
+        static_cast<double>(episodes - a.episode) / static_cast<double>(b.episode - a.episode);
     switch (interpolation_) {
       case ScheduleInterpolation::kStep:
         return a.beta_m;

@@ -6,7 +6,7 @@
 namespace auvrl::task {
 
 namespace {
-constexpr int kPaperFixed = 3 + 3 + 6;         // x_pos, x_e, v
+constexpr int kPaperFixed = 3 + 3 + 6;             // x_pos, x_e, v
 constexpr int kExtendedFixed = 3 + 1 + 6 + 6 + 1;  // e_body, d, sin/cos, v, depth
 // Offsets of the extended layout.
 constexpr int kExtError = 0, kExtDistance = 3, kExtTrig = 4, kExtVelocity = 10, kExtAction = 16;
@@ -138,7 +138,8 @@ Eigen::Vector3d position_from_state(const TaskConfig& c, const Eigen::Vector3d& 
   if (c.layout == StateLayout::kPaper) {
     return state.segment<3>(kPaperPosition).cast<double>() * c.scales.position_m;
   }
-  const Eigen::Vector3d error_body = state.segment<3>(kExtError).cast<double>() * c.scales.position_m;
+  const Eigen::Vector3d error_body =
+      state.segment<3>(kExtError).cast<double>() * c.scales.position_m;
   return goal - rotation_from_state(state) * error_body;
 }
 

@@ -40,7 +40,7 @@ const char* to_string(RewardKind kind);
 
 /// Fixed scales that bring every input to roughly [-1, 1] (documented in the README).
 struct ObservationScales {
-  double position_m = 10.0;       ///< positions and goal errors
+  double position_m = 10.0;  ///< positions and goal errors
   double linear_velocity_mps = 1.0;
   double angular_rate_rad_s = 1.0;
   double depth_m = 10.0;
@@ -54,8 +54,8 @@ struct TaskConfig {
   double max_thrust_n = 39.24;  ///< action +-1 maps to +-this, N
 
   RewardKind reward = RewardKind::kPaper;
-  double goal_reward = 10.0;      ///< on reaching the goal radius beta
-  double step_penalty = 1.0;      ///< the "-1" of Eq. 14, per step
+  double goal_reward = 10.0;  ///< on reaching the goal radius beta
+  double step_penalty = 1.0;  ///< the "-1" of Eq. 14, per step
   /// f(Tr) = thrust_weight * mean(u_i^2) with u the normalised command in [-1, 1]: the paper
   /// weights thruster usage without giving f; a quadratic cost is the usual energy proxy.
   double thrust_weight = 0.1;
@@ -70,7 +70,7 @@ struct TaskConfig {
   bool hold_mode = false;
   double hold_reward_per_step = 1.0;
 
-  int max_steps = 700;            ///< 70 s of 0.1 s steps: a cut-off, not a terminal state
+  int max_steps = 700;  ///< 70 s of 0.1 s steps: a cut-off, not a terminal state
   double control_step_s = 0.1;
 
   Eigen::Vector3d start_position_ned_m{0.0, 0.0, 5.0};

@@ -64,9 +64,10 @@ ClientResult run_client(int vehicle_id, int steps) {
 }
 
 void print(const char* placement, int clients, int index, int steps, const ClientResult& r) {
-  std::printf("lockstep placement=%s clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f "
-              "p99_us=%.1f failures=%d\n",
-              placement, clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
+  std::printf(
+      "lockstep placement=%s clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f "
+      "p99_us=%.1f failures=%d\n",
+      placement, clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
   std::fflush(stdout);
 }
 

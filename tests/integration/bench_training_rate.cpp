@@ -42,7 +42,8 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
                                      "0.25"};
     if (pinned) {
       argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(i % cpus)});
-      argv.insert(argv.end(), {"--first-vehicle-id", std::to_string(i), "--lockstep-lcm-url", url(i)});
+      argv.insert(argv.end(),
+                  {"--first-vehicle-id", std::to_string(i), "--lockstep-lcm-url", url(i)});
     } else {
       argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
     }
@@ -55,12 +56,20 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
        "--replay", "200000"},
       dir + "/learner.log");
   for (int id = 0; id < actors; ++id) {
-    std::vector<std::string> argv = {test_support::bin_path("auv_actor"), "--actor-id",
-                                     std::to_string(id), "--seed", std::to_string(id + 1),
-                                     "--reward", "shaped", "--noise", "gaussian", "--layout",
+    std::vector<std::string> argv = {test_support::bin_path("auv_actor"),
+                                     "--actor-id",
+                                     std::to_string(id),
+                                     "--seed",
+                                     std::to_string(id + 1),
+                                     "--reward",
+                                     "shaped",
+                                     "--noise",
+                                     "gaussian",
+                                     "--layout",
                                      "extended"};
     if (pinned) {
-      argv.insert(argv.end(), {"--pin-cpu", std::to_string(id % cpus), "--lockstep-lcm-url", url(id)});
+      argv.insert(argv.end(),
+                  {"--pin-cpu", std::to_string(id % cpus), "--lockstep-lcm-url", url(id)});
     }
     procs.push_back(std::make_unique<test_support::ChildProcess>(
         argv, dir + "/actor" + std::to_string(id) + ".log"));
@@ -83,12 +92,13 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
   std::optional<auvrl_lcm::learner_stats_t> last_stats = stats.take();
   const double steps_per_s = static_cast<double>(total_steps() - first) / dt;
   const double updates_per_s =
-      first_stats && last_stats ? static_cast<double>(last_stats->updates - first_stats->updates) / dt
-                                : 0.0;
-  std::printf("training placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
-              "updates_per_s=%.0f updates_per_transition=%s\n",
-              pinned ? "pinned" : "shared", actors, dt, steps_per_s, updates_per_s,
-              learner_ratio.c_str());
+      first_stats && last_stats
+          ? static_cast<double>(last_stats->updates - first_stats->updates) / dt
+          : 0.0;
+  std::printf(
+      "training placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
+      "updates_per_s=%.0f updates_per_transition=%s\n",
+      pinned ? "pinned" : "shared", actors, dt, steps_per_s, updates_per_s, learner_ratio.c_str());
   std::fflush(stdout);
 }
 

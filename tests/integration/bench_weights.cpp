@@ -45,7 +45,8 @@ void subscriber(const std::string& result_path, const std::string& stop_path) {
   std::sort(latency_ms.begin(), latency_ms.end());
   std::ofstream out(result_path);
   const auto pct = [&](double p) {
-    return latency_ms.empty() ? 0.0 : latency_ms[static_cast<std::size_t>(p * (latency_ms.size() - 1))];
+    return latency_ms.empty() ? 0.0
+                              : latency_ms[static_cast<std::size_t>(p * (latency_ms.size() - 1))];
   };
   out << latency_ms.size() << " " << bytes << " " << pct(0.5) << " " << pct(0.99) << "\n";
 }
@@ -95,8 +96,8 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
   }
   test_support::ChildProcess learner(
       {test_support::bin_path("auv_learner"), "--state-dim", std::to_string(kStateDim),
-       "--action-dim", std::to_string(kActionDim), "--hidden", hidden, "--batch", "64",
-       "--replay", "100000"},
+       "--action-dim", std::to_string(kActionDim), "--hidden", hidden, "--batch", "64", "--replay",
+       "100000"},
       dir + "/learner.log");
   auto transport = transport::make_transport({});
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
@@ -127,11 +128,12 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
     long received = 0, bytes = 0;
     double p50 = 0, p99 = 0;
     in >> received >> bytes >> p50 >> p99;
-    std::printf("weights hidden=%s bytes=%ld published=%lld subscriber=%d received=%ld "
-                "delivery=%.4f p50_ms=%.2f p99_ms=%.2f updates=%lld\n",
-                hidden.c_str(), bytes, static_cast<long long>(published), k, received,
-                published > 0 ? static_cast<double>(received) / static_cast<double>(published) : 0.0,
-                p50, p99, static_cast<long long>(last ? last->updates : -1));
+    std::printf(
+        "weights hidden=%s bytes=%ld published=%lld subscriber=%d received=%ld "
+        "delivery=%.4f p50_ms=%.2f p99_ms=%.2f updates=%lld\n",
+        hidden.c_str(), bytes, static_cast<long long>(published), k, received,
+        published > 0 ? static_cast<double>(received) / static_cast<double>(published) : 0.0, p50,
+        p99, static_cast<long long>(last ? last->updates : -1));
   }
   std::fflush(stdout);
 }

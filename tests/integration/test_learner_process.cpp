@@ -96,18 +96,30 @@ struct FakeActor {
 
 std::vector<std::string> learner_args(const std::string& dir, bool resume) {
   std::vector<std::string> args = {test_support::bin_path("auv_learner"),
-                                   "--algo", "td3",
-                                   "--state-dim", std::to_string(kStateDim),
-                                   "--action-dim", std::to_string(kActionDim),
-                                   "--hidden", "32-32",
-                                   "--batch", std::to_string(kBatch),
-                                   "--replay", "5000",
-                                   "--broadcast-every", "1",
-                                   "--broadcast-interval", "0",
-                                   "--max-actors", "4",
-                                   "--checkpoint-dir", dir + "/checkpoints",
-                                   "--checkpoint-period", "0.3",
-                                   "--seed", "5"};
+                                   "--algo",
+                                   "td3",
+                                   "--state-dim",
+                                   std::to_string(kStateDim),
+                                   "--action-dim",
+                                   std::to_string(kActionDim),
+                                   "--hidden",
+                                   "32-32",
+                                   "--batch",
+                                   std::to_string(kBatch),
+                                   "--replay",
+                                   "5000",
+                                   "--broadcast-every",
+                                   "1",
+                                   "--broadcast-interval",
+                                   "0",
+                                   "--max-actors",
+                                   "4",
+                                   "--checkpoint-dir",
+                                   dir + "/checkpoints",
+                                   "--checkpoint-period",
+                                   "0.3",
+                                   "--seed",
+                                   "5"};
   if (resume) args.push_back("--resume");
   return args;
 }
@@ -166,7 +178,8 @@ TEST(LearnerProcess, WeightsRiseCheckpointKillResume) {
   // Every version from the first update to the last was broadcast (after each update).
   std::vector<std::int64_t> seen = a.versions;
   seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
-  EXPECT_EQ(seen.size(), static_cast<std::size_t>(240 - kBatch + 1)) << "weights were not broadcast after each update";
+  EXPECT_EQ(seen.size(), static_cast<std::size_t>(240 - kBatch + 1))
+      << "weights were not broadcast after each update";
 
   // Hostile batches: dropped and counted, never applied.
   auto bad = a.make_batch(5);

@@ -147,10 +147,10 @@ TEST_F(SimProcess, MalformedMessagesAreDroppedAndCounted) {
   transport_->publish(channels::sim_command(0), garbage, sizeof garbage);
 
   ASSERT_TRUE(wait_heartbeat([](const auto& hb) {
-    return hb.dropped_vehicle_id >= 2 && hb.dropped_thrusters >= 1 &&
-           hb.dropped_non_finite >= 1 && hb.dropped_not_reset >= 1 &&
-           hb.dropped_out_of_range >= 1 && hb.dropped_decode >= 1;
-  })) << "counters: vehicle_id " << last_heartbeat_.dropped_vehicle_id;
+    return hb.dropped_vehicle_id >= 2 && hb.dropped_thrusters >= 1 && hb.dropped_non_finite >= 1 &&
+           hb.dropped_not_reset >= 1 && hb.dropped_out_of_range >= 1 && hb.dropped_decode >= 1;
+  })) << "counters: vehicle_id "
+      << last_heartbeat_.dropped_vehicle_id;
   EXPECT_EQ(last_heartbeat_.steps_total, 0);
   EXPECT_TRUE(sim_->running());
 

@@ -10,7 +10,8 @@ episodes.csv and in a trajectory) and missing files (progress.csv, the PID's cur
 trajectory). The test checks that the script exits 0, writes the expected figures, that
 report.md holds the table values computed from the fabricated rows, names the damaged rows by
 file and line and the missing files, and that its figure links resolve; and that a run
-directory with nothing in it, and a path that is not a directory, are handled.
+directory with nothing in it, one of binary junk and non-finite numbers, and a path that is not
+a directory, are handled.
 Exits 77 (CTest: skipped) when Debian's python3-matplotlib or python3-numpy is missing.
 """
 import math
@@ -230,6 +231,35 @@ class PlotRunTest(unittest.TestCase):
         self.assertIn("No evaluation in this run", report)
         self.assertIn("No training logs in this run", report)
         self.assertEqual(os.listdir(os.path.join(empty, "plots")), [])
+
+    def test_garbage_inputs(self):
+        """Binary junk, headers only, non-finite numbers, a missing column: still exit 0."""
+        junk = os.path.join(self.tmp.name, "junk")
+        header = trajectory(5.0).splitlines()[0]
+        write(os.path.join(junk, "eval/policy/summary.csv"), SUMMARY_HEADER + "\n")
+        write(os.path.join(junk, "eval/policy/trajectories/test1_0.csv"), header + "\n")
+        rows = trajectory(5.0).splitlines()[:40]
+        rows.append("4.0,nan,inf,-inf" + ",0" * (len(header.split(",")) - 4))
+        write(os.path.join(junk, "eval/policy/trajectories/test2_0.csv"), "\n".join(rows))
+        with open(os.path.join(junk, "eval/policy/trajectories/fault_0.csv"), "wb") as f:
+            f.write(bytes(range(256)) * 20)
+        os.makedirs(os.path.join(junk, "eval/pid"))
+        with open(os.path.join(junk, "eval/pid/summary.csv"), "wb") as f:
+            f.write(bytes(range(255, -1, -1)) * 20)
+        write(os.path.join(junk, "episodes.csv"), "wall_s,return\n1.0,-5\n")
+        write(os.path.join(junk, "learner.csv"), "wall_s,updates\n1,5\n2,nan\n")
+        write(os.path.join(junk, "progress.csv"), "")
+        proc = subprocess.run([PYTHON, SCRIPT, junk], capture_output=True, text=True,
+                              timeout=120)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertNotIn("Traceback", proc.stderr)
+        with open(os.path.join(junk, "report.md")) as f:
+            report = f.read()
+        self.assertIn("eval/pid/summary.csv: header lacks column(s)", report)
+        self.assertIn("eval/policy/trajectories/fault_0.csv: header lacks column(s) t, x, y, z",
+                      report)
+        self.assertIn("progress.csv: empty file", report)
+        self.assertTrue(os.path.isfile(os.path.join(junk, "plots", "eval_test2_position.png")))
 
     def test_not_a_directory(self):
         missing = os.path.join(self.tmp.name, "no_such_run")

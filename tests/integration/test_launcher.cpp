@@ -1,0 +1,168 @@
+// auvrl train as a real process (inside this test's private network namespace): it supervises
+// (an actor killed with SIGKILL is back within seconds), stops cleanly on Ctrl-C with a
+// checkpoint and the policy written, resumes, and a short run of the fast preset learns: the
+// evaluated policy does far better than an untrained one.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "agent/evaluation.hpp"
+#include "child_process.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace {
+
+using namespace auvrl;
+namespace fs = std::filesystem;
+using test_support::ChildProcess;
+
+const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+
+/// Rows of a CSV file as maps from column to text.
+std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+  const auto split = [](const std::string& text) {
+    std::vector<std::string> cells;
+    std::stringstream ss(text);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    return cells;
+  };
+  if (std::getline(in, line)) header = split(line);
+  while (std::getline(in, line)) {
+    const auto cells = split(line);
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int read_pid(const fs::path& path) {
+  std::ifstream in(path);
+  int pid = -1;
+  in >> pid;
+  return pid;
+}
+
+bool wait_for(const std::function<bool()>& condition, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (condition()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return condition();
+}
+
+TEST(Launcher, RestartsAKilledActorStopsCleanlyAndResumes) {
+  const std::string dir = test_support::make_temp_dir("auvrl_launcher_") + "/run";
+  ChildProcess train(
+      {test_support::bin_path("auvrl"), "train", "--config", kPreset, "--run-dir", dir, "--network",
+       "host", "--actors", "2", "--max-seconds", "60", "--no-eval"},
+      dir + ".log");
+  const fs::path run(dir);
+  ASSERT_TRUE(wait_for([&] { return read_csv(run / "episodes.csv").size() >= 20; }, 30))
+      << train.log();
+  const int actor = read_pid(run / "processes" / "actor0.pid");
+  ASSERT_GT(actor, 0);
+  ASSERT_EQ(kill(actor, SIGKILL), 0);
+  const double killed_at = std::atof(read_csv(run / "episodes.csv").back()["wall_s"].c_str());
+  // Back within seconds, and reporting episodes again.
+  ASSERT_TRUE(wait_for(
+      [&] {
+        for (const auto& row : read_csv(run / "episodes.csv")) {
+          if (row.at("actor_id") == "0" && std::atof(row.at("wall_s").c_str()) > killed_at + 0.5) {
+            return true;
+          }
+        }
+        return false;
+      },
+      15))
+      << train.log();
+  EXPECT_NE(train.log().find("actor0 ended (signal 9); restarting"), std::string::npos)
+      << train.log();
+  EXPECT_NE(read_pid(run / "processes" / "actor0.pid"), actor);
+
+  // Ctrl-C: everything stops, the learner checkpoints and writes the policy.
+  train.signal(SIGINT);
+  const int status = train.wait_for_exit(std::chrono::seconds(60));
+  ASSERT_TRUE(WIFEXITED(status)) << train.log();
+  EXPECT_EQ(WEXITSTATUS(status), 130) << train.log();
+  EXPECT_NE(train.log().find("continue it: auvrl train --resume"), std::string::npos);
+  EXPECT_TRUE(fs::exists(run / "policy.nn"));
+  EXPECT_FALSE(fs::is_empty(run / "checkpoints"));
+  EXPECT_FALSE(fs::is_empty(run / "logs"));
+  const auto learner_rows = read_csv(run / "learner.csv");
+  ASSERT_FALSE(learner_rows.empty());
+  const long updates_before = std::atol(learner_rows.back().at("updates").c_str());
+
+  // --resume continues from the checkpoint (update count does not start again from zero).
+  ChildProcess resumed({test_support::bin_path("auvrl"), "train", "--resume", dir, "--network",
+                        "host", "--max-seconds", "0.001", "--no-eval"},
+                       dir + "-resume.log");
+  ASSERT_GE(resumed.wait_for_exit(std::chrono::seconds(60)), 0) << resumed.log();
+  const std::string log = [&] {
+    std::ifstream in(run / "processes" / "learner.log");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  }();
+  EXPECT_NE(log.find("resumed from"), std::string::npos) << log;
+  EXPECT_GT(updates_before, 0);
+}
+
+TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
+  const std::string dir = test_support::make_temp_dir("auvrl_launcher_learn_") + "/run";
+  ChildProcess train({test_support::bin_path("auvrl"), "train", "--config", kPreset, "--run-dir",
+                      dir, "--network", "host", "--max-seconds", "60"},
+                     dir + ".log");
+  const int status = train.wait_for_exit(std::chrono::seconds(240));
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << train.log();
+  const auto rows = read_csv(fs::path(dir) / "eval" / "policy" / "summary.csv");
+  int reached = 0, suite = 0;
+  double final_error = 0;
+  for (const auto& row : rows) {
+    if (row.at("scenario") != "suite") continue;
+    ++suite;
+    reached += row.at("reached") == "1";
+    final_error += std::atof(row.at("final_error_m").c_str());
+  }
+  ASSERT_EQ(suite, 100) << train.log();
+  final_error /= suite;
+
+  // The untrained policy: the same architecture, freshly initialised.
+  const sim::VehicleModel model =
+      sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml");
+  nn::Mlp trained =
+      nn::network_from_bytes(nn::read_file((std::filesystem::path(dir) / "policy.nn").string()), 1);
+  nn::Mlp untrained(trained.spec(), 1);
+  nn::Rng rng(99);
+  untrained.init_lillicrap(rng);
+  agent::EvaluationConfig config;
+  config.task.layout = task::StateLayout::kExtended;
+  agent::PolicyController controller(untrained, config.task.state_dim(), 6);
+  const auto baseline =
+      agent::run_evaluation(model, config, controller, {agent::Scenario::kSuite}, "");
+  int baseline_reached = 0;
+  double baseline_error = 0;
+  for (const auto& r : baseline) {
+    baseline_reached += r.reached;
+    baseline_error += r.final_error_m;
+  }
+  baseline_error /= baseline.size();
+  std::cout << "suite reached: trained " << reached << "/100 (mean final error " << final_error
+            << " m), untrained " << baseline_reached << "/100 (" << baseline_error << " m)\n";
+  EXPECT_GE(reached, baseline_reached + 30);
+  EXPECT_LT(final_error, 0.5 * baseline_error);
+}
+
+}  // namespace
