@@ -862,6 +862,10 @@ def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
         tscale, tunit = 3600.0, "h"
     n = 0 if tr.ep is None else tr.ep["n"].size
     w = window_for(n)
+    n_title = n
+    for d in (tr.learner, tr.progress):  # no episodes.csv: the 1 Hz logs' episode count
+        if n_title == 0 and d is not None and finite(d["episodes"]).size:
+            n_title = int(finite(d["episodes"]).max())
     names = []
     for mode in modes:
         fig, axes = plt.subplots(3, 3, figsize=(15, 10.5), squeeze=False)
@@ -954,10 +958,10 @@ def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
               missing="episodes.csv, progress.csv", ylim=(-0.03, 1.03))
         panel(2, "distance to way-point at the end", [(ep, "ep", ep_dist)], "m",
               logy="auto", missing="episodes.csv")
-        beta_src = [(ep, "ep", beta_of("episodes.csv"))] if ep is not None else \
-            [(pr, "pr", beta_of("progress.csv")), (le, "le", beta_of("learner.csv"))][:1]
-        if ep is None and pr is None:
-            beta_src = [(le, "le", beta_of("learner.csv"))]
+        # beta from the first log that has it: per episode, else the 1 Hz logs.
+        beta_src = [next(((d, src, beta_of(name)) for d, src, name in (
+            (ep, "ep", "episodes.csv"), (pr, "pr", "progress.csv"), (le, "le", "learner.csv"))
+            if d is not None), (None, "", None))]
         panel(3, "goal radius beta (curriculum)", beta_src, "m", logy="auto",
               missing="episodes.csv, progress.csv, learner.csv")
         panel(4, "critic loss", [(le, "le", learner_col("critic_loss", "tab:red",
@@ -984,7 +988,7 @@ def plot_training(tr, plots_dir, written, modes=("episodes", "time")):
         if mode == "time":
             for ax in axes[0]:
                 ax.set_xlabel(xlabel, fontsize=8)
-        fig.suptitle(f"training against {xlabel.split(' (')[0]} ({n} episodes, "
+        fig.suptitle(f"training against {xlabel.split(' (')[0]} ({n_title} episodes, "
                      f"{fmt_duration(wall)} wall-clock)", fontsize=11)
         fig.subplots_adjust(left=0.06, right=0.98, bottom=0.06, top=0.93, hspace=0.35,
                             wspace=0.25)

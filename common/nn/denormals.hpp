@@ -35,17 +35,6 @@ class ScopedFlushDenormals {
   ScopedFlushDenormals(const ScopedFlushDenormals&) = delete;
   ScopedFlushDenormals& operator=(const ScopedFlushDenormals&) = delete;
 
-  /// Sets the mode for the calling thread for good (for worker threads that run products).
-  static void enable_for_this_thread() noexcept {
-#if defined(__SSE__)
-    _mm_setcsr(_mm_getcsr() | kDazFtz);
-#elif defined(__aarch64__)
-    unsigned long v;
-    __asm__ __volatile__("mrs %0, fpcr" : "=r"(v));
-    __asm__ __volatile__("msr fpcr, %0" ::"r"(v | kFz));
-#endif
-  }
-
  private:
 #if defined(__SSE__)
   static constexpr unsigned int kDazFtz = 0x8040;  // FTZ (bit 15) | DAZ (bit 6)

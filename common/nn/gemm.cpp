@@ -10,6 +10,8 @@
 
 #include <algorithm>
 
+#include "common/nn/denormals.hpp"
+
 #if defined(__AVX512F__) && !defined(AUVRL_NN_PORTABLE)
 #define AUVRL_GEMM_AVX512 1
 #include <immintrin.h>
@@ -233,6 +235,8 @@ void run(Index m, Index n, Index k, const float* a, Index lda, const float* b, I
     const Index blocks = (n + kNr - 1) / kNr;
 #pragma omp parallel num_threads(threads)
     {
+      // Worker threads do not inherit the caller's floating-point mode.
+      const ScopedFlushDenormals flush;
       const Index t = omp_get_thread_num();
       const Index nt = omp_get_num_threads();
       const Index j0 = blocks * t / nt * kNr;

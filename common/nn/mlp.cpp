@@ -381,18 +381,7 @@ void soft_update(Mlp& target, const Mlp& source, float tau) {
   target.params() = tau * source.params() + (1.0f - tau) * target.params();
 }
 
-void set_num_threads(int n) {
-  n = std::max(n, 1);
-  Eigen::setNbThreads(n);
-#if defined(_OPENMP)
-  // OpenMP keeps its worker threads: give each the denormal mode that the calling thread gets
-  // inside every pass (see ScopedFlushDenormals).
-  if (n > 1) {
-#pragma omp parallel num_threads(n)
-    ScopedFlushDenormals::enable_for_this_thread();
-  }
-#endif
-}
+void set_num_threads(int n) { Eigen::setNbThreads(std::max(n, 1)); }
 
 int num_threads() { return Eigen::nbThreads(); }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/nn/gemm.hpp"
+#include "common/nn/mlp.hpp"
 
 namespace auvrl::nn::gemm {
 namespace {
@@ -81,6 +82,32 @@ TEST(Gemm, AllShapesAndEpiloguesMatchEigen) {
       }
     }
   }
+}
+
+// With two threads a large product is split by columns: the result must be the same, bit for
+// bit (each entry is still summed by one thread in the same order).
+TEST(Gemm, TwoThreadsGiveTheSameResult) {
+  const Eigen::Index m = 256, n = 100, k = 256;
+  const MatrixXf a = MatrixXf::Random(m, k), b = MatrixXf::Random(k, n);
+  const MatrixXf bt = MatrixXf::Random(n, k), mask = MatrixXf::Random(m, n);
+  const Eigen::VectorXf bias = Eigen::VectorXf::Random(m);
+  std::vector<float> scratch(static_cast<std::size_t>(m * k));
+  auto products = [&] {
+    std::vector<MatrixXf> out(3, MatrixXf(m, n));
+    multiply_nn(m, n, k, a.data(), m, b.data(), k, out[0].data(), m, Epilogue::kBiasRelu,
+                bias.data());
+    multiply_tn(m, n, k, a.data(), m, b.data(), k, out[1].data(), m, scratch.data(),
+                Epilogue::kReluMask, mask.data(), m);
+    MatrixXf c(m, k);
+    multiply_nt(m, k, n, out[0].data(), m, bt.transpose().eval().data(), k, c.data(), m);
+    out[2] = c.leftCols(n);
+    return out;
+  };
+  const std::vector<MatrixXf> one = products();
+  set_num_threads(2);
+  const std::vector<MatrixXf> two = products();
+  set_num_threads(1);
+  for (std::size_t i = 0; i < one.size(); ++i) EXPECT_EQ(one[i], two[i]) << i;
 }
 
 }  // namespace
