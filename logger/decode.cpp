@@ -15,24 +15,8 @@ namespace {
 constexpr std::uint64_t kMaxZeroSizeElements = 1u << 20;
 
 std::uint64_t element_min_size(const Member& member) {
-  if (!member.is_primitive) return member.nested->min_encoded_size;
-  switch (member.primitive) {
-    case Primitive::kInt8:
-    case Primitive::kByte:
-    case Primitive::kBoolean:
-      return 1;
-    case Primitive::kInt16:
-      return 2;
-    case Primitive::kInt32:
-    case Primitive::kFloat:
-      return 4;
-    case Primitive::kInt64:
-    case Primitive::kDouble:
-      return 8;
-    case Primitive::kString:
-      return 5;
-  }
-  return 1;
+  return member.is_primitive ? primitive_min_size(member.primitive)
+                             : member.nested->min_encoded_size;
 }
 
 /// Walks the bytes of one message body with a cursor, appending columns.

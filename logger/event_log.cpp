@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 
 namespace auvrl::logger {
@@ -266,6 +267,15 @@ std::vector<std::string> expand_log_paths(const std::vector<std::string>& argume
     paths.insert(paths.end(), found.begin(), found.end());
   }
   return paths;
+}
+
+std::string utc_text(std::int64_t utime) {
+  const std::time_t t = static_cast<std::time_t>(utime / 1000000);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char text[40];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return text;
 }
 
 }  // namespace auvrl::logger

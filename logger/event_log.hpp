@@ -136,4 +136,7 @@ class RotatingLogWriter {
 /// *.lcmlog files in name order (the order the writer numbered them).
 std::vector<std::string> expand_log_paths(const std::vector<std::string>& arguments);
 
+/// An LCM timestamp (microseconds since the Unix epoch) as ISO 8601 UTC text.
+std::string utc_text(std::int64_t utime);
+
 }  // namespace auvrl::logger

@@ -73,15 +73,6 @@ void report_problems(const ReadReport& report, const Schema& schema, std::ostrea
   }
 }
 
-std::string utc_text(std::int64_t utime) {
-  const std::time_t t = static_cast<std::time_t>(utime / 1000000);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char text[40];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
 /// The union of the columns of a channel's messages, in encoding order (see
 /// column_order_key): variable arrays of different lengths share one header in which every
 /// element sits where it belongs. Types are ordered by first appearance (a channel normally

@@ -23,15 +23,6 @@ Clock::duration seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
 }
 
-std::string utc_text(std::int64_t utime) {
-  const std::time_t t = static_cast<std::time_t>(utime / 1000000);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char text[40];
-  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return text;
-}
-
 }  // namespace
 
 ThrottleRule parse_throttle_rule(const std::string& text) {

@@ -321,26 +321,6 @@ std::uint64_t recursive_hash(const StructType& type, std::vector<const StructTyp
   return (hash << 1) + ((hash >> 63) & 1);
 }
 
-std::uint64_t primitive_min_size(Primitive primitive) {
-  switch (primitive) {
-    case Primitive::kInt8:
-    case Primitive::kByte:
-    case Primitive::kBoolean:
-      return 1;
-    case Primitive::kInt16:
-      return 2;
-    case Primitive::kInt32:
-    case Primitive::kFloat:
-      return 4;
-    case Primitive::kInt64:
-    case Primitive::kDouble:
-      return 8;
-    case Primitive::kString:
-      return 5;  // int32 length (NUL included) and the NUL
-  }
-  return 1;
-}
-
 constexpr std::uint64_t kSizeCap = std::uint64_t{1} << 62;
 
 std::uint64_t saturating_multiply(std::uint64_t a, std::uint64_t b) {
@@ -376,6 +356,26 @@ std::string read_file(const std::string& path) {
 }
 
 }  // namespace
+
+std::uint64_t primitive_min_size(Primitive primitive) {
+  switch (primitive) {
+    case Primitive::kInt8:
+    case Primitive::kByte:
+    case Primitive::kBoolean:
+      return 1;
+    case Primitive::kInt16:
+      return 2;
+    case Primitive::kInt32:
+    case Primitive::kFloat:
+      return 4;
+    case Primitive::kInt64:
+    case Primitive::kDouble:
+      return 8;
+    case Primitive::kString:
+      return 5;  // int32 length (NUL included) and the NUL
+  }
+  return 1;
+}
 
 const char* primitive_name(Primitive primitive) {
   for (const auto& info : kPrimitives) {

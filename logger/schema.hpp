@@ -27,6 +27,9 @@ enum class Primitive { kInt8, kInt16, kInt32, kInt64, kByte, kFloat, kDouble, kS
 /// The LCM spelling of a primitive ("int8_t", "byte", ...).
 const char* primitive_name(Primitive primitive);
 
+/// Fewest bytes one value of a primitive encodes to (a string: length and NUL, 5).
+std::uint64_t primitive_min_size(Primitive primitive);
+
 struct StructType;
 
 /// One array dimension of a member: a constant size ("[3]") or the value of an earlier integer

@@ -21,6 +21,7 @@
 #include "common/channels.hpp"
 #include "common/cli.hpp"
 #include "common/transport.hpp"
+#include "synthetic_experience.hpp"
 
 namespace {
 
@@ -51,32 +52,6 @@ void subscriber(const std::string& result_path, const std::string& stop_path) {
   out << latency_ms.size() << " " << bytes << " " << pct(0.5) << " " << pct(0.99) << "\n";
 }
 
-auvrl_lcm::experience_batch_t synthetic_batch(int n, std::int64_t seq, std::mt19937& rng) {
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  auvrl_lcm::experience_batch_t b{};
-  b.actor_id = 0;
-  b.batch_seq = seq;
-  b.state_dim = kStateDim;
-  b.action_dim = kActionDim;
-  b.num_transitions = n;
-  for (int i = 0; i < n; ++i) {
-    std::vector<float> s(kStateDim), s2(kStateDim), a(kActionDim);
-    for (auto& v : s) v = u(rng);
-    for (auto& v : s2) v = u(rng);
-    for (auto& v : a) v = u(rng);
-    b.states.push_back(s);
-    b.next_states.push_back(s2);
-    b.actions.push_back(a);
-    b.rewards.push_back(u(rng));
-    b.terminal.push_back(0);
-    b.achieved_position_ned_m.push_back({0, 0, 0});
-    b.goal_ned_m.push_back({0, 0, 0});
-    b.episode_id.push_back(seq);
-    b.step_index.push_back(i);
-  }
-  return b;
-}
-
 void run_case(const std::string& hidden, double seconds, int subscribers) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
   const std::string stop_path = dir + "/stop";
@@ -101,13 +76,14 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
       dir + "/learner.log");
   auto transport = transport::make_transport({});
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
-  std::mt19937 rng(1);
   std::int64_t seq = 0;
   // Experience at 2,000 transitions/s, in batches of 20 (an actor's rate on this machine).
   const auto end = Clock::now() + std::chrono::duration<double>(seconds);
   auto next = Clock::now();
   while (Clock::now() < end) {
-    transport::publish(*transport, channels::kExperience, synthetic_batch(20, ++seq, rng));
+    transport::publish(
+        *transport, channels::kExperience,
+        test_support::synthetic_experience_batch(0, ++seq, 20, kStateDim, kActionDim));
     next += std::chrono::milliseconds(10);
     std::this_thread::sleep_until(next);
     transport->drain();

@@ -19,6 +19,7 @@
 #include "common/nn/serialize.hpp"
 #include "learner/checkpoint.hpp"
 #include "learner/learner_node.hpp"
+#include "synthetic_experience.hpp"
 
 namespace {
 
@@ -51,30 +52,7 @@ struct FakeActor {
 
   /// A batch of n transitions whose values follow from (actor, seq): reproducible.
   auvrl_lcm::experience_batch_t make_batch(int n) {
-    auvrl_lcm::experience_batch_t b{};
-    b.actor_id = actor_id;
-    b.batch_seq = ++seq;
-    b.state_dim = kStateDim;
-    b.action_dim = kActionDim;
-    b.num_transitions = n;
-    std::mt19937 rng(static_cast<unsigned>(actor_id * 100000 + seq));
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    for (int i = 0; i < n; ++i) {
-      std::vector<float> s(kStateDim), s2(kStateDim), a(kActionDim);
-      for (auto& v : s) v = u(rng);
-      for (auto& v : s2) v = u(rng);
-      for (auto& v : a) v = u(rng);
-      b.states.push_back(s);
-      b.next_states.push_back(s2);
-      b.actions.push_back(a);
-      b.rewards.push_back(u(rng));
-      b.terminal.push_back(i % 17 == 0);
-      b.achieved_position_ned_m.push_back({u(rng), u(rng), u(rng)});
-      b.goal_ned_m.push_back({1.0f, 2.0f, 3.0f});
-      b.episode_id.push_back(seq);
-      b.step_index.push_back(i);
-    }
-    return b;
+    return test_support::synthetic_experience_batch(actor_id, ++seq, n, kStateDim, kActionDim);
   }
 
   void send(const auvrl_lcm::experience_batch_t& b) {
