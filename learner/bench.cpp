@@ -117,7 +117,7 @@ std::string format_bench_line(const BenchResult& r) {
   }
   os << " batch=" << r.config.batch << " threads=" << r.config.threads
      << " updates_per_s=" << static_cast<long>(std::lround(r.updates_per_s));
-  if (r.config.state_dim != 29 || r.config.action_dim != 6) {
+  if (r.config.state_dim != 23 || r.config.action_dim != 6) {
     os << " state_dim=" << r.config.state_dim << " action_dim=" << r.config.action_dim;
   }
   return os.str();

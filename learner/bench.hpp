@@ -11,7 +11,8 @@
 namespace auvrl::learner {
 
 /// One benchmark case. The defaults are the AUV task's dimensions (the extended state layout:
-/// 29 values; the paper's layout [x_pos, x_e, v, u_prev] would be 3 + 3 + 6 + 6 = 18).
+/// 3 + 1 + 6 + 6 + 6 + 1 = 23 values; the paper's layout [x_pos, x_e, v, u_prev] is
+/// 3 + 3 + 6 + 6 = 18).
 struct BenchCase {
   Algo algo = Algo::kDdpg;
   std::vector<int> hidden{256, 256};  ///< both actor and critic
@@ -21,7 +22,7 @@ struct BenchCase {
   /// descheduled worker stalls the others for a time slice (measured here with the two cores
   /// busy: 4-10 updates/s instead of hundreds).
   int threads = 1;
-  int state_dim = 29;
+  int state_dim = 23;
   int action_dim = 6;
   double seconds = 2.0;  ///< measuring time, after a short warm-up
 };
@@ -50,7 +51,7 @@ BenchResult run_update_benchmark(Algo algo, const std::vector<int>& hidden, int 
 std::vector<BenchCase> standard_bench_cases(Algo algo);
 
 /// "algo=ddpg hidden=256-256 batch=256 threads=1 updates_per_s=N"; for dims other than the AUV
-/// task's (29, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken.
+/// task's (23, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken.
 std::string format_bench_line(const BenchResult& r);
 /// Writes format_bench_line(r) and a newline.
 void print_bench_line(std::ostream& os, const BenchResult& r);

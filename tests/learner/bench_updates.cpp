@@ -1,4 +1,4 @@
-// Prints the learner's update rates: the three standard cases (AUV dims 29/6, one thread), for
+// Prints the learner's update rates: the three standard cases (AUV dims 23/6, one thread), for
 // DDPG and TD3, and the same with pendulum dims (state 3, action 1), as RLtools reports them.
 // Usage: bench_updates [seconds per case]. Not a CTest test.
 #include <cstdlib>
