@@ -210,3 +210,45 @@ TEST_F(SimProcess, StopsCleanlyOnSigterm) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SimProcessRealTime, StepsAtWallClockRateWithTheLatestCommand) {
+  const std::string dir = test_support::make_temp_dir("auvrl_sim_realtime_");
+  ChildProcess sim({test_support::bin_path("auv_sim"), "--vehicle", kVehicleFile, "--realtime",
+                    "--vehicles", "1"},
+                   dir + "/auv_sim.log");
+  auto transport = transport::make_transport({});
+  std::vector<auvrl_lcm::vehicle_state_t> states;
+  transport::subscribe<auvrl_lcm::vehicle_state_t>(
+      *transport, channels::sim_state(0),
+      [&](const std::string&, const auvrl_lcm::vehicle_state_t& s) { states.push_back(s); });
+  auvrl_lcm::vehicle_reset_t reset = test_reset();
+  reset.vehicle_id = 0;
+  reset.seq = 1;
+  // auv_sim may still be starting: reset until it answers.
+  for (int i = 0; i < 50 && states.empty(); ++i) {
+    transport::publish(*transport, channels::sim_reset(0), reset);
+    transport->handle(100);
+  }
+  ASSERT_FALSE(states.empty()) << sim.log();
+  auvrl_lcm::thruster_cmd_t cmd{};
+  cmd.vehicle_id = 0;
+  cmd.seq = 2;
+  cmd.num_thrusters = 6;
+  cmd.thrust_n = {30, 30, 0, 0, 0, 0};
+  transport::publish(*transport, channels::sim_command(0), cmd);
+  states.clear();
+  const auto start = std::chrono::steady_clock::now();
+  while (std::chrono::steady_clock::now() - start < std::chrono::seconds(2)) transport->handle(50);
+  // 2 s of wall clock at 0.1 s per step: about 20 states, each one step further.
+  EXPECT_GE(states.size(), 17u) << sim.log();
+  EXPECT_LE(states.size(), 23u) << sim.log();
+  for (std::size_t i = 1; i < states.size(); ++i) {
+    EXPECT_EQ(states[i].step_count, states[i - 1].step_count + 1);
+  }
+  // The held command drives the vehicle forward.
+  EXPECT_GT(states.back().velocity_body_mps[0], states.front().velocity_body_mps[0]);
+}
+
+}  // namespace
