@@ -63,12 +63,36 @@ bool wait_for(const std::function<bool()>& condition, double seconds) {
   return condition();
 }
 
-TEST(Launcher, RestartsAKilledActorStopsCleanlyAndResumes) {
-  const std::string dir = test_support::make_temp_dir("auvrl_launcher_") + "/run";
+/// The fast preset with checkpoints every 2 s (so a killed learner has one to resume from).
+std::string quick_checkpoint_config(const std::string& dir) {
+  std::ifstream in(kPreset);
+  const std::string path = dir + "/fast_quick_checkpoints.yaml";
+  std::ofstream out(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) == 0) {
+      line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+    } else if (line.find("checkpoint_period_s:") != std::string::npos) {
+      line = "  checkpoint_period_s: 2";
+    }
+    out << line << "\n";
+  }
+  return path;
+}
+
+TEST(Launcher, RestartsKilledProcessesStopsCleanlyAndResumes) {
+  const std::string tmp = test_support::make_temp_dir("auvrl_launcher_");
+  const std::string dir = tmp + "/run";
   ChildProcess train(
-      {test_support::bin_path("auvrl"), "train", "--config", kPreset, "--run-dir", dir, "--network",
-       "host", "--actors", "2", "--max-seconds", "60", "--no-eval"},
+      {test_support::bin_path("auvrl"), "train", "--config", quick_checkpoint_config(tmp),
+       "--run-dir", dir, "--network", "host", "--actors", "2", "--max-seconds", "60", "--no-eval"},
       dir + ".log");
+  const auto learner_log = [&] {
+    std::ifstream in(fs::path(dir) / "processes" / "learner.log");
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
   const fs::path run(dir);
   ASSERT_TRUE(wait_for([&] { return read_csv(run / "episodes.csv").size() >= 20; }, 30))
       << train.log();
@@ -92,6 +116,17 @@ TEST(Launcher, RestartsAKilledActorStopsCleanlyAndResumes) {
       << train.log();
   EXPECT_NE(read_pid(run / "processes" / "actor0.pid"), actor);
 
+  // The learner killed after its first checkpoint comes back from that checkpoint.
+  ASSERT_TRUE(wait_for([&] { return !fs::is_empty(run / "checkpoints"); }, 20)) << train.log();
+  ASSERT_EQ(kill(read_pid(run / "processes" / "learner.pid"), SIGKILL), 0);
+  ASSERT_TRUE(wait_for([&] { return learner_log().find("resumed from") != std::string::npos; }, 20))
+      << train.log() << learner_log();
+  EXPECT_NE(train.log().find("learner ended (signal 9); restarting"), std::string::npos);
+  // Training goes on after it: more episodes arrive.
+  const std::size_t episodes_now = read_csv(run / "episodes.csv").size();
+  EXPECT_TRUE(
+      wait_for([&] { return read_csv(run / "episodes.csv").size() > episodes_now + 5; }, 20));
+
   // Ctrl-C: everything stops, the learner checkpoints and writes the policy.
   train.signal(SIGINT);
   const int status = train.wait_for_exit(std::chrono::seconds(60));
@@ -105,18 +140,19 @@ TEST(Launcher, RestartsAKilledActorStopsCleanlyAndResumes) {
   ASSERT_FALSE(learner_rows.empty());
   const long updates_before = std::atol(learner_rows.back().at("updates").c_str());
 
-  // --resume continues from the checkpoint (update count does not start again from zero).
+  // --resume continues from the newest checkpoint.
+  const auto count_resumes = [&] {
+    std::size_t n = 0, pos = 0;
+    const std::string log = learner_log();
+    while ((pos = log.find("resumed from", pos)) != std::string::npos) ++n, ++pos;
+    return n;
+  };
+  const std::size_t resumes_before = count_resumes();
   ChildProcess resumed({test_support::bin_path("auvrl"), "train", "--resume", dir, "--network",
                         "host", "--max-seconds", "0.001", "--no-eval"},
                        dir + "-resume.log");
   ASSERT_GE(resumed.wait_for_exit(std::chrono::seconds(60)), 0) << resumed.log();
-  const std::string log = [&] {
-    std::ifstream in(run / "processes" / "learner.log");
-    std::stringstream text;
-    text << in.rdbuf();
-    return text.str();
-  }();
-  EXPECT_NE(log.find("resumed from"), std::string::npos) << log;
+  EXPECT_EQ(count_resumes(), resumes_before + 1) << learner_log();
   EXPECT_GT(updates_before, 0);
 }
 
