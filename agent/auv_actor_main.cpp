@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
              "run configuration (YAML: task, schedule, actor); the options below override it");
   cmd.option("actor-id", &config.actor_id, "this actor's id (0..)");
   cmd.option("vehicle-id", &vehicle_id, "its vehicle in auv_sim (default: the actor id)");
-  cmd.option("layout", &layout, "state layout: paper or extended");
+  cmd.option("layout", &layout, "state layout: paper, extended or extended_thrust");
   cmd.option("reward", &reward, "reward: paper (Eq. 14) or shaped");
   cmd.option("failure-reward", &config.task.failure_reward,
              "reward on leaving beta_max or flipping (paper -10; -1/(1-gamma) fixes it)");

@@ -37,7 +37,8 @@ int run_eval(int argc, const char* const* argv) {
   cli.option("out", &request.out_dir, "output directory (created)");
   cli.option("vehicle", &request.vehicle_path, "vehicle file");
   cli.option("layout", &request.layout,
-             "paper|extended (default: from the policy's inputs, 12+n / 17+n)");
+             "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
+             "/ 17+2n)");
   cli.option("seed", &seed, "seed of the suite's way-points and the vehicle resets");
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
   cli.option("suite-trajectories", &request.suite_trajectories,

@@ -73,7 +73,8 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
   task::ActionVector previous_action = task::ActionVector::Zero(n);
   task::ActionVector action(n);
   task::StateVector state, next_state;
-  task::build_state(task, report->observation, goal, previous_action, state);
+  task::build_state(task, report->observation, goal, previous_action, state,
+                    report->thrust_realised_n);
   double distance = (goal - report->observation.position_ned_m).norm();
   summary.min_distance_m = distance;
   std::vector<double> thrust_n(static_cast<std::size_t>(n));
@@ -100,7 +101,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
     const task::StepOutcome outcome = task::evaluate_step(
         task, distance, next_distance, task::is_flipped(task, next->observation.euler_rpy_rad),
         action, options.beta_m, t);
-    task::build_state(task, next->observation, goal, action, next_state);
+    task::build_state(task, next->observation, goal, action, next_state, next->thrust_realised_n);
 
     if (!task_ended) {
       if (options.on_transition) {

@@ -328,11 +328,15 @@ std::string format_summary_table(const std::vector<SummaryRow>& rows) {
 task::StateLayout infer_layout(int input_dim, int num_thrusters) {
   if (input_dim == kPaperFixedInputs + num_thrusters) return task::StateLayout::kPaper;
   if (input_dim == kExtendedFixedInputs + num_thrusters) return task::StateLayout::kExtended;
-  throw std::invalid_argument("a policy with " + std::to_string(input_dim) +
-                              " inputs fits no state layout for " + std::to_string(num_thrusters) +
-                              " thrusters: expected " +
-                              std::to_string(kPaperFixedInputs + num_thrusters) + " (paper) or " +
-                              std::to_string(kExtendedFixedInputs + num_thrusters) + " (extended)");
+  if (input_dim == kExtendedFixedInputs + 2 * num_thrusters) {
+    return task::StateLayout::kExtendedThrust;
+  }
+  throw std::invalid_argument(
+      "a policy with " + std::to_string(input_dim) + " inputs fits no state layout for " +
+      std::to_string(num_thrusters) + " thrusters: expected " +
+      std::to_string(kPaperFixedInputs + num_thrusters) + " (paper), " +
+      std::to_string(kExtendedFixedInputs + num_thrusters) + " (extended) or " +
+      std::to_string(kExtendedFixedInputs + 2 * num_thrusters) + " (extended_thrust)");
 }
 
 std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,

@@ -125,8 +125,8 @@ void write_trajectory_csv(const std::string& path, const std::vector<TrajectoryR
 std::string format_summary_table(const std::vector<SummaryRow>& rows);
 
 /// The state layout a policy network was trained with, from its input size: 12 + n is the
-/// paper's layout (18 with six thrusters), 17 + n the extended one (23). Throws
-/// std::invalid_argument if it is neither.
+/// paper's layout (18 with six thrusters), 17 + n the extended one (23), 17 + 2n the extended
+/// one with the thrusters' realised thrust (29). Throws std::invalid_argument otherwise.
 task::StateLayout infer_layout(int input_dim, int num_thrusters);
 
 /// What `auvrl eval` was asked to do.
@@ -136,7 +136,7 @@ struct EvalRequest {
   std::string scenario = "all";
   std::string out_dir;       ///< required
   std::string vehicle_path;  ///< vehicle file
-  std::string layout;        ///< "paper", "extended" or empty: inferred from the policy
+  std::string layout;        ///< "paper", "extended", "extended_thrust" or empty: from the policy
   std::uint64_t seed = 1;
   int suite_episodes = 100;
   int suite_trajectories = 10;

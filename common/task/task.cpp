@@ -17,11 +17,21 @@ constexpr int kPaperPosition = 0, kPaperError = 3, kPaperVelocity = 6, kPaperAct
 StateLayout parse_layout(const std::string& name) {
   if (name == "paper") return StateLayout::kPaper;
   if (name == "extended") return StateLayout::kExtended;
-  throw std::invalid_argument("state layout '" + name + "': expected paper or extended");
+  if (name == "extended_thrust") return StateLayout::kExtendedThrust;
+  throw std::invalid_argument("state layout '" + name +
+                              "': expected paper, extended or extended_thrust");
 }
 
 const char* to_string(StateLayout layout) {
-  return layout == StateLayout::kPaper ? "paper" : "extended";
+  switch (layout) {
+    case StateLayout::kPaper:
+      return "paper";
+    case StateLayout::kExtended:
+      return "extended";
+    case StateLayout::kExtendedThrust:
+      return "extended_thrust";
+  }
+  return "?";
 }
 
 RewardKind parse_reward_kind(const std::string& name) {
@@ -33,7 +43,8 @@ RewardKind parse_reward_kind(const std::string& name) {
 const char* to_string(RewardKind kind) { return kind == RewardKind::kPaper ? "paper" : "shaped"; }
 
 int TaskConfig::state_dim() const {
-  return (layout == StateLayout::kPaper ? kPaperFixed : kExtendedFixed) + num_thrusters;
+  if (layout == StateLayout::kPaper) return kPaperFixed + num_thrusters;
+  return kExtendedFixed + (layout == StateLayout::kExtendedThrust ? 2 : 1) * num_thrusters;
 }
 
 void TaskConfig::validate() const {
@@ -50,12 +61,13 @@ void TaskConfig::validate() const {
   positive(beta_max_m, "beta_max_m");
   positive(flip_angle_rad, "flip_angle_rad");
   positive(control_step_s, "control_step_s");
+  positive(precision_scale_m, "precision_scale_m");
   if (num_thrusters < 1 || num_thrusters > 64) {
     throw std::invalid_argument("task.num_thrusters must be in 1..64");
   }
   if (max_steps < 1) throw std::invalid_argument("task.max_steps must be >= 1");
   for (double v : {goal_reward, step_penalty, thrust_weight, failure_reward, progress_weight,
-                   hold_reward_per_step, start_yaw_rad}) {
+                   hold_reward_per_step, distance_weight, precision_reward, start_yaw_rad}) {
     if (!std::isfinite(v)) throw std::invalid_argument("task: a reward constant is not finite");
   }
   if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
@@ -76,7 +88,8 @@ Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& e) {
 }
 
 void build_state(const TaskConfig& c, const Observation& obs, const Eigen::Vector3d& goal,
-                 const ActionVector& previous_action, StateVector& out) {
+                 const ActionVector& previous_action, StateVector& out,
+                 const std::vector<double>& thrust_realised_n) {
   if (previous_action.size() != c.num_thrusters) {
     throw std::invalid_argument("build_state: previous action has " +
                                 std::to_string(previous_action.size()) + " entries, expected " +
@@ -106,6 +119,18 @@ void build_state(const TaskConfig& c, const Observation& obs, const Eigen::Vecto
       (obs.angular_rate_body_rad_s / k.angular_rate_rad_s).cast<float>();
   out.segment(kExtAction, c.num_thrusters) = previous_action;
   out[kExtAction + c.num_thrusters] = static_cast<float>(obs.position_ned_m[2] / k.depth_m);
+  if (c.layout == StateLayout::kExtendedThrust) {
+    if (thrust_realised_n.size() != static_cast<std::size_t>(c.num_thrusters)) {
+      throw std::invalid_argument("build_state: the extended_thrust layout needs the thrust of " +
+                                  std::to_string(c.num_thrusters) + " thrusters, got " +
+                                  std::to_string(thrust_realised_n.size()));
+    }
+    const int first = kExtAction + c.num_thrusters + 1;
+    for (int i = 0; i < c.num_thrusters; ++i) {
+      out[first + i] =
+          static_cast<float>(thrust_realised_n[static_cast<std::size_t>(i)] / c.max_thrust_n);
+    }
+  }
 }
 
 namespace {
@@ -173,7 +198,9 @@ StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, 
   if (c.reward == RewardKind::kPaper) {
     out.reward = -c.step_penalty - cost;
   } else {
-    out.reward = c.progress_weight * (d_before - d_after) - c.step_penalty - cost;
+    out.reward = c.progress_weight * (d_before - d_after) - c.step_penalty - cost -
+                 c.distance_weight * d_after +
+                 c.precision_reward * std::exp(-d_after / c.precision_scale_m);
   }
   if (out.inside_goal) out.reward += c.hold_reward_per_step;  // hold mode only
   if (steps_taken >= c.max_steps) {

@@ -33,6 +33,9 @@ void read_task_config(config::Section s, TaskConfig& c) {
   s.read("flip_angle_rad", c.flip_angle_rad);
   s.read("hold_mode", c.hold_mode);
   s.read("hold_reward_per_step", c.hold_reward_per_step);
+  s.read("distance_weight", c.distance_weight);
+  s.read("precision_reward", c.precision_reward);
+  s.read("precision_scale_m", c.precision_scale_m);
   s.read("max_steps", c.max_steps);
   s.read("control_step_s", c.control_step_s);
   s.read("start_position_ned_m", c.start_position_ned_m);

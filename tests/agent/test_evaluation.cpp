@@ -239,6 +239,8 @@ TEST(Evaluation, InfersTheLayoutFromThePolicyInputs) {
   EXPECT_EQ(infer_layout(18, 6), task::StateLayout::kPaper);
   EXPECT_EQ(infer_layout(23, 6), task::StateLayout::kExtended);
   EXPECT_EQ(infer_layout(20, 8), task::StateLayout::kPaper);
+  EXPECT_EQ(infer_layout(29, 6), task::StateLayout::kExtendedThrust);
+  EXPECT_EQ(infer_layout(33, 8), task::StateLayout::kExtendedThrust);
   EXPECT_THROW(infer_layout(19, 6), std::invalid_argument);
 }
 
@@ -303,7 +305,8 @@ TEST(EvalCommand, ClearErrorsForBadPolicyFiles) {
   request.policy_path = dir.path("odd.net");
   error = controller_error(request, config);
   EXPECT_NE(error.find("odd.net"), std::string::npos) << error;
-  EXPECT_NE(error.find("18 (paper) or 23 (extended)"), std::string::npos) << error;
+  EXPECT_NE(error.find("18 (paper), 23 (extended) or 29 (extended_thrust)"), std::string::npos)
+      << error;
 
   // An explicit layout that the network does not fit.
   nn::save_network_file(dir.path("extended.net"), actor(23));

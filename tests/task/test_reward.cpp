@@ -132,6 +132,42 @@ TEST(Reward, ShapedProgressSign) {
   EXPECT_DOUBLE_EQ(evaluate_step(c, 19.0, 21.0, false, a, 0.5, 1).reward, c.failure_reward);
 }
 
+TEST(Reward, ShapedDistanceAndPrecisionTerms) {
+  TaskConfig c;
+  c.reward = RewardKind::kShaped;
+  c.hold_mode = true;
+  c.hold_reward_per_step = 1.0;
+  c.step_penalty = 0.1;
+  c.thrust_weight = 0.0;
+  c.distance_weight = 0.2;
+  c.precision_reward = 2.0;
+  c.precision_scale_m = 0.25;
+  const ActionVector a = uniform_action(0.0f);
+  // Far away: progress - step - distance term + a vanishing precision bonus.
+  EXPECT_NEAR(evaluate_step(c, 5.1, 5.0, false, a, 0.5, 1).reward,
+              10.0 * 0.1 - 0.1 - 0.2 * 5.0 + 2.0 * std::exp(-5.0 / 0.25), 1e-12);
+  // Holding still inside beta: closer pays more (the flat hold reward alone does not).
+  const StepOutcome near = evaluate_step(c, 0.1, 0.1, false, a, 0.5, 50);
+  const StepOutcome rim = evaluate_step(c, 0.4, 0.4, false, a, 0.5, 50);
+  EXPECT_NEAR(near.reward, -0.1 - 0.02 + 2.0 * std::exp(-0.4) + 1.0, 1e-12);
+  EXPECT_NEAR(rim.reward, -0.1 - 0.08 + 2.0 * std::exp(-1.6) + 1.0, 1e-12);
+  EXPECT_GT(near.reward, rim.reward);
+  EXPECT_FALSE(near.done);
+  // At the goal itself the bonus is whole.
+  EXPECT_NEAR(evaluate_step(c, 0.0, 0.0, false, a, 0.5, 50).reward, -0.1 + 2.0 + 1.0, 1e-12);
+  // Failure is still the failure reward alone.
+  EXPECT_DOUBLE_EQ(evaluate_step(c, 19.0, 21.0, false, a, 0.5, 1).reward, c.failure_reward);
+}
+
+TEST(Reward, PaperRewardIgnoresTheShapedTerms) {
+  TaskConfig c;  // the paper's Eq. 14
+  c.distance_weight = 0.5;
+  c.precision_reward = 3.0;
+  c.progress_weight = 10.0;
+  EXPECT_DOUBLE_EQ(evaluate_step(c, 5.0, 4.0, false, uniform_action(0.0f), 0.5, 1).reward, -1.0);
+  EXPECT_DOUBLE_EQ(evaluate_step(c, 0.8, 0.1, false, uniform_action(0.0f), 0.5, 1).reward, 10.0);
+}
+
 TEST(TaskConfig, ValidateRejectsUnusableValues) {
   EXPECT_NO_THROW(TaskConfig{}.validate());
   TaskConfig c;
@@ -149,12 +185,20 @@ TEST(TaskConfig, ValidateRejectsUnusableValues) {
   c = TaskConfig{};
   c.failure_reward = std::numeric_limits<double>::infinity();
   EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.precision_scale_m = 0.0;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.distance_weight = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
 TEST(TaskConfig, ParsesNames) {
   EXPECT_EQ(parse_layout("paper"), StateLayout::kPaper);
   EXPECT_EQ(parse_layout("extended"), StateLayout::kExtended);
   EXPECT_THROW(parse_layout("Paper"), std::invalid_argument);
+  EXPECT_EQ(parse_layout("extended_thrust"), StateLayout::kExtendedThrust);
+  EXPECT_STREQ(to_string(StateLayout::kExtendedThrust), "extended_thrust");
   EXPECT_EQ(parse_reward_kind("shaped"), RewardKind::kShaped);
   EXPECT_EQ(parse_reward_kind(to_string(RewardKind::kPaper)), RewardKind::kPaper);
   EXPECT_THROW(parse_reward_kind("dense"), std::invalid_argument);

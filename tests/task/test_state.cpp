@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include "common/task/task.hpp"
 
@@ -21,9 +22,10 @@ TaskConfig config(StateLayout layout) {
 }
 
 StateVector build(const TaskConfig& c, const Observation& obs, const Eigen::Vector3d& goal,
-                  const ActionVector& previous) {
+                  const ActionVector& previous,
+                  const std::vector<double>& thrust_n = std::vector<double>(6, 0.0)) {
   StateVector s;
-  build_state(c, obs, goal, previous, s);
+  build_state(c, obs, goal, previous, s, thrust_n);
   return s;
 }
 
@@ -35,13 +37,17 @@ Eigen::Vector3d body_error_m(const TaskConfig& c, const StateVector& s) {
 TEST(StateLayout, Dimensions) {
   EXPECT_EQ(config(StateLayout::kPaper).state_dim(), 18);
   EXPECT_EQ(config(StateLayout::kExtended).state_dim(), 23);
+  EXPECT_EQ(config(StateLayout::kExtendedThrust).state_dim(), 29);
   TaskConfig c = config(StateLayout::kPaper);
   c.num_thrusters = 8;
   EXPECT_EQ(c.state_dim(), 20);
   c.layout = StateLayout::kExtended;
   EXPECT_EQ(c.state_dim(), 25);
+  c.layout = StateLayout::kExtendedThrust;
+  EXPECT_EQ(c.state_dim(), 33);
   const Observation obs;
-  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
     const TaskConfig t = config(layout);
     EXPECT_EQ(build(t, obs, Eigen::Vector3d(1, 2, 3), ActionVector::Zero(6)).size(), t.state_dim());
   }
@@ -180,8 +186,32 @@ Observation random_observation(std::mt19937_64& rng) {
   return o;
 }
 
+TEST(StateLayout, ExtendedThrustIsTheExtendedStateThenTheNormalisedThrust) {
+  TaskConfig ext = config(StateLayout::kExtended);
+  TaskConfig thr = config(StateLayout::kExtendedThrust);
+  ext.max_thrust_n = thr.max_thrust_n = 40.0;
+  std::mt19937_64 rng(5);
+  const Observation obs = random_observation(rng);
+  ActionVector prev(6);
+  prev << 0.1f, -0.2f, 0.3f, -0.4f, 0.5f, -0.6f;
+  const std::vector<double> thrust = {40.0, -40.0, 20.0, -10.0, 0.0, 4.0};
+  const Eigen::Vector3d goal(7.0, 6.0, 10.0);
+  const StateVector e = build(ext, obs, goal, prev, thrust);
+  const StateVector t = build(thr, obs, goal, prev, thrust);
+  ASSERT_EQ(t.size(), e.size() + 6);
+  EXPECT_EQ(t.head(e.size()), e);  // the extended state, entry for entry
+  const float expected[] = {1.0f, -1.0f, 0.5f, -0.25f, 0.0f, 0.1f};
+  for (int i = 0; i < 6; ++i) EXPECT_FLOAT_EQ(t[e.size() + i], expected[i]) << i;
+  // The thrust is required, one value per thruster.
+  StateVector s;
+  EXPECT_THROW(build_state(thr, obs, goal, prev, s), std::invalid_argument);
+  EXPECT_THROW(build_state(thr, obs, goal, prev, s, std::vector<double>(5, 0.0)),
+               std::invalid_argument);
+}
+
 TEST(Relabel, EqualsBuildingTheStateForTheNewGoal) {
-  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
     const TaskConfig c = config(layout);
     std::mt19937_64 rng(42);
     std::uniform_real_distribution<double> goal(-10.0, 10.0);
@@ -192,9 +222,11 @@ TEST(Relabel, EqualsBuildingTheStateForTheNewGoal) {
       const Eigen::Vector3d new_goal(goal(rng), goal(rng), 8.0 + 0.7 * goal(rng));
       ActionVector prev(6);
       for (int k = 0; k < 6; ++k) prev[k] = act(rng);
-      StateVector relabelled = build(c, obs, old_goal, prev);
+      std::vector<double> thrust(6);
+      for (double& f : thrust) f = 39.24 * act(rng);
+      StateVector relabelled = build(c, obs, old_goal, prev, thrust);
       relabel_state(c, old_goal, new_goal, relabelled);
-      const StateVector direct = build(c, obs, new_goal, prev);
+      const StateVector direct = build(c, obs, new_goal, prev, thrust);
       ASSERT_EQ(relabelled.size(), direct.size());
       EXPECT_LT((relabelled - direct).cwiseAbs().maxCoeff(), 2e-6f)
           << to_string(layout) << " sample " << i;
@@ -213,8 +245,9 @@ TEST(Relabel, ToTheSameGoalChangesNothing) {
   EXPECT_LT((s - before).cwiseAbs().maxCoeff(), 1e-6f);
 }
 
-TEST(PositionFromState, RecoversThePositionInBothLayouts) {
-  for (StateLayout layout : {StateLayout::kPaper, StateLayout::kExtended}) {
+TEST(PositionFromState, RecoversThePositionInEveryLayout) {
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
     const TaskConfig c = config(layout);
     std::mt19937_64 rng(11);
     for (int i = 0; i < 200; ++i) {
