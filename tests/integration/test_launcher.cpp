@@ -184,7 +184,7 @@ TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
   nn::Rng rng(99);
   untrained.init_lillicrap(rng);
   agent::EvaluationConfig config;
-  config.task.layout = task::StateLayout::kExtended;
+  config.task.layout = agent::infer_layout(trained.spec().input_dim, 6);
   agent::PolicyController controller(untrained, config.task.state_dim(), 6);
   const auto baseline =
       agent::run_evaluation(model, config, controller, {agent::Scenario::kSuite}, "");
