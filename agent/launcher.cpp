@@ -311,15 +311,13 @@ int run_training(const TrainOptions& options, std::ostream& out) {
       argv.insert(argv.end(), {"--lockstep-lcm-url", lockstep_url(i)});
     sims.push_back(add_role("sim" + std::to_string(i), fixed(argv)));
   }
-  std::vector<std::string> learner_argv = {bin + "auv_learner",
-                                           "--config",
-                                           config_path,
-                                           "--checkpoint-dir",
-                                           (run_dir / "checkpoints").string(),
-                                           "--policy-out",
-                                           (run_dir / "policy.nn").string(),
-                                           "--max-actors",
-                                           std::to_string(std::max(actors, 1))};
+  std::vector<std::string> learner_argv = {bin + "auv_learner", "--config", config_path,
+                                           "--checkpoint-dir", (run_dir / "checkpoints").string(),
+                                           "--policy-out", (run_dir / "policy.nn").string(),
+                                           "--max-actors", std::to_string(std::max(actors, 1)),
+                                           // The run's seed also seeds the networks, the
+                                           // minibatches and TD3's noise.
+                                           "--seed", std::to_string(rc.run.seed)};
   if (rc.run.learner_cpu >= 0 && rc.run.learner_cpu < cpus) {
     learner_argv.insert(learner_argv.begin(),
                         {"/usr/bin/taskset", "-c", std::to_string(rc.run.learner_cpu)});

@@ -208,8 +208,8 @@ void Reader::expect_magic(const char* magic) {
     std::string printable;
     for (char c : got) printable += (c >= 32 && c < 127) ? c : '?';
     // The magic ends in a NUL: print it as text up to there, so the message is not cut.
-    fail("bad magic: expected '" + std::string(magic, strnlen(magic, 8)) + "', got '" +
-         printable + "' (not this kind of file, or damaged)");
+    fail("bad magic: expected '" + std::string(magic, strnlen(magic, 8)) + "', got '" + printable +
+         "' (not this kind of file, or damaged)");
   }
 }
 

@@ -74,8 +74,8 @@ TEST(LoggerProcess, LogsExactlyWhatWasSentExportsAndReplaysIt) {
   transport->subscribe(
       "SIM_STATE_[0-9]+", [&](const transport::RawMessage& raw) { ++received[raw.channel]; },
       100000);
-  transport::Latest<auvrl_lcm::logger_heartbeat_t> logger_heartbeat(
-      *transport, channels::kLoggerHeartbeat);
+  transport::Latest<auvrl_lcm::logger_heartbeat_t> logger_heartbeat(*transport,
+                                                                    channels::kLoggerHeartbeat);
   transport::Latest<auvrl_lcm::sim_heartbeat_t> sim_heartbeat(*transport, channels::kSimHeartbeat);
   // Both processes are up and listening once their heartbeats arrive.
   const auto deadline = Clock::now() + std::chrono::seconds(10);
