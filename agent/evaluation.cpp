@@ -169,7 +169,9 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   options.reach_radius_m = config.reach_radius_m;
   options.run_full_time = true;
   options.trajectory = trajectory;
-  const EpisodeSummary s = run_episode(config.task, *link, controller, options);
+  task::TaskConfig task = config.task;
+  task.max_steps = config.episode_steps;
+  const EpisodeSummary s = run_episode(task, *link, controller, options);
 
   SummaryRow row;
   row.scenario = to_string(episode.scenario);
@@ -192,6 +194,7 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
   config.task.num_thrusters = model.num_thrusters();
   config.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
   config.task.control_step_s = model.control_step_s;
+  config.task.max_steps = config.episode_steps;  // checked here; each episode applies it
   config.task.validate();
   if (!(config.reach_radius_m > 0)) {
     throw std::invalid_argument("evaluation: reach radius must be > 0");

@@ -64,6 +64,9 @@ struct EvaluationConfig {
   int suite_episodes = 100;
   std::uint64_t seed = 1;       ///< suite way-points and the vehicle resets
   int suite_trajectories = 10;  ///< trajectory files for the first this many; -1: all
+  /// Every episode runs this many control steps (700 = 70 s), whatever task.max_steps the
+  /// policy was trained with (shorter training episodes must not shorten the evaluation).
+  int episode_steps = 700;
 };
 
 /// One episode of a scenario: where it starts, where it goes, what is broken.

@@ -224,6 +224,19 @@ TEST(Evaluation, NeverReachedLeavesTheReachCellsEmpty) {
   }
 }
 
+TEST(Evaluation, EpisodesRunTheEvaluationLengthNotTheTrainingOne) {
+  TempDir dir;
+  EvaluationConfig c;
+  c.task.max_steps = 50;  // a short training episode
+  PidController pid(nessie());
+  run_evaluation(nessie(), c, pid, {Scenario::kTest1}, dir.path("out"));
+  const auto trajectory = read_csv(dir.path("out/trajectories/test1_0.csv"));
+  EXPECT_EQ(trajectory.size(), 1u + 1u + 700u);  // header, the reset state, 700 steps
+  c.episode_steps = 120;
+  run_evaluation(nessie(), c, pid, {Scenario::kTest1}, dir.path("short"));
+  EXPECT_EQ(read_csv(dir.path("short/trajectories/test1_0.csv")).size(), 1u + 1u + 120u);
+}
+
 TEST(Evaluation, SummaryTableHasOneLinePerScenario) {
   PidController pid(nessie());
   EvaluationConfig c;
