@@ -36,6 +36,49 @@ inline const std::string kSimCommandPattern = "SIM_CMD_[0-9]+";
 inline const std::string kSimResetPattern = "SIM_RESET_[0-9]+";
 inline const std::string kSimFaultPattern = "SIM_FAULT_[0-9]+";
 
+/// How a transport that distinguishes kinds of traffic (Cyclone DDS; LCM treats every channel
+/// alike) must carry a channel. Which class a channel belongs to is decided here, by the
+/// prefixes of kChannelClassPrefixes, and nowhere else.
+enum class ChannelClass {
+  /// Self-superseding state (policy weights and their summary): only the newest matters, and a
+  /// late joiner must get it at once without asking (reliable, keep-last-1, transient-local).
+  kState,
+  /// Every message matters (experience, episode reports, weights requests): reliable with a
+  /// bounded history, so a slow reader makes the writer wait (back-pressure) instead of losing.
+  kQueue,
+  /// The simulator's lockstep loop (commands, states, resets, faults): latency first; the sim
+  /// client asks again by sequence number if an answer is missing.
+  kLockstep,
+  /// Everything else (heartbeats, statistics): reliable, a small keep-last history.
+  kOther,
+};
+
+/// A channel name prefix and the class of the channels that begin with it.
+struct ChannelClassPrefix {
+  const char* prefix;
+  ChannelClass channel_class;
+};
+
+/// The channel classes, by prefix (first match wins; no match: kOther).
+inline constexpr ChannelClassPrefix kChannelClassPrefixes[] = {
+    {"POLICY_", ChannelClass::kState},          // POLICY_WEIGHTS, POLICY_SUMMARY
+    {"EXPERIENCE", ChannelClass::kQueue},       //
+    {"EPISODE", ChannelClass::kQueue},          //
+    {"WEIGHTS_REQUEST", ChannelClass::kQueue},  //
+    {"SIM_CMD_", ChannelClass::kLockstep},      //
+    {"SIM_STATE_", ChannelClass::kLockstep},    //
+    {"SIM_RESET_", ChannelClass::kLockstep},    //
+    {"SIM_FAULT_", ChannelClass::kLockstep},
+};
+
+/// The class of a channel (see kChannelClassPrefixes).
+inline ChannelClass channel_class(const std::string& channel) {
+  for (const ChannelClassPrefix& p : kChannelClassPrefixes) {
+    if (channel.rfind(p.prefix, 0) == 0) return p.channel_class;
+  }
+  return ChannelClass::kOther;
+}
+
 /// The vehicle id at the end of a per-vehicle channel name, or -1 if there is none.
 inline int vehicle_id_of(const std::string& channel) {
   const auto underscore = channel.rfind('_');

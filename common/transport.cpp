@@ -7,6 +7,8 @@
 #include <map>
 #include <regex>
 
+#include "common/transport_dds.hpp"
+
 namespace auvrl::transport {
 
 namespace {
@@ -139,9 +141,31 @@ int Transport::handle(int timeout_ms) {
   return 1 + drain();
 }
 
+std::string to_string(TransportKind kind) { return kind == TransportKind::kDds ? "dds" : "lcm"; }
+
+TransportKind parse_transport_kind(const std::string& text) {
+  if (text == "lcm") return TransportKind::kLcm;
+  if (text == "dds") return TransportKind::kDds;
+  throw TransportError("unknown transport '" + text + "' (expected lcm or dds)");
+}
+
 std::unique_ptr<Transport> make_transport(const TransportConfig& config) {
+  if (config.kind == TransportKind::kDds) {
+    return make_dds_transport(config.dds, config.allow_off_host);
+  }
   check_url_is_host_only(config.lcm_url, config.allow_off_host);
   return std::make_unique<LcmTransport>(config.lcm_url);
+}
+
+std::string describe(const TransportConfig& config) {
+  if (config.kind == TransportKind::kLcm) return config.lcm_url;
+  std::string text = "dds domain " + std::to_string(config.dds.domain_id);
+  if (!config.dds.config_path.empty()) return text + ", config " + config.dds.config_path;
+  text += ", peers ";
+  for (std::size_t i = 0; i < config.dds.peers.size(); ++i) {
+    text += (i ? "," : "") + config.dds.peers[i];
+  }
+  return text;
 }
 
 std::unique_ptr<Transport> make_in_process_transport() {

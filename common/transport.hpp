@@ -1,6 +1,6 @@
 // The one transport every process uses: publish and subscribe LCM-encoded messages by channel.
-// Nothing above this layer knows which wire carries the bytes (LCM UDP multicast today;
-// Cyclone DDS is the second implementation the design plans for).
+// Nothing above this layer knows which wire carries the bytes: LCM UDP multicast (the default)
+// or Cyclone DDS (common/transport_dds.hpp), chosen by TransportConfig::kind.
 #pragma once
 
 #include <cstdint>
@@ -20,13 +20,48 @@ namespace auvrl::transport {
 inline constexpr const char* kDefaultLcmUrl =
     "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=8388608";
 
+/// Which implementation carries the messages.
+enum class TransportKind {
+  kLcm,  ///< LCM (UDP multicast by default; lcm_url)
+  kDds,  ///< Cyclone DDS (unicast discovery, reliable, transient-local state; dds)
+};
+
+/// "lcm" or "dds".
+std::string to_string(TransportKind kind);
+/// Parses "lcm" or "dds"; throws TransportError naming the accepted values otherwise.
+TransportKind parse_transport_kind(const std::string& text);
+
+/// Cyclone DDS settings. Without config_path the transport generates its Cyclone configuration:
+/// interface lo (when every peer is a loopback address), multicast off, unicast discovery of
+/// the listed peers, participant index auto up to max_auto_participant_index.
+struct DdsSettings {
+  /// DDS domain id, 0..232 (the UDP ports are 7400 + 250 * domain + ...).
+  int domain_id = 0;
+  /// Hosts (addresses or names) where other participants run; discovery is unicast to them.
+  /// Anything but loopback addresses needs allow_off_host.
+  std::vector<std::string> peers = {"127.0.0.1"};
+  /// A Cyclone XML file that replaces the generated configuration entirely (needs
+  /// allow_off_host: it may bind any interface).
+  std::string config_path;
+  /// Processes per host and domain: each needs a participant index (Cyclone's default, 9,
+  /// stops the tenth process on a host).
+  int max_auto_participant_index = 120;
+  /// Lockstep channels (SIM_CMD_/SIM_STATE_/...): reliable (true) or best effort. The sim
+  /// client resends a command whose answer is missing, so best effort would be safe too;
+  /// reliable was as fast on loopback (see README, bench_lockstep --transport dds).
+  bool lockstep_reliable = true;
+};
+
 /// Which transport to open and how.
 struct TransportConfig {
   std::string lcm_url = kDefaultLcmUrl;
   /// LCM has no authentication: anyone on the multicast group can inject commands or weights.
   /// A URL whose traffic can leave the host (udpm with ttl > 0 or without ttl) is refused
-  /// unless this is set explicitly.
+  /// unless this is set explicitly; so are DDS peers that are not loopback addresses and a
+  /// DDS configuration file.
   bool allow_off_host = false;
+  TransportKind kind = TransportKind::kLcm;
+  DdsSettings dds;
 };
 
 /// Raised when a transport cannot be opened or a configuration is refused.
@@ -76,8 +111,13 @@ class Transport {
   int handle(int timeout_ms);
 };
 
-/// Opens the transport the configuration names.
+/// Opens the transport the configuration names; throws TransportError (refused or broken
+/// configuration, transport that cannot start).
 std::unique_ptr<Transport> make_transport(const TransportConfig& config);
+
+/// Where the configuration sends the messages, for log lines ("udpm://..." or "dds domain 0,
+/// peers 127.0.0.1").
+std::string describe(const TransportConfig& config);
 
 /// An in-process transport (LCM's memq://) for tests and single-process tools.
 std::unique_ptr<Transport> make_in_process_transport();

@@ -1,0 +1,494 @@
+#include "common/transport_dds.hpp"
+
+#include <dds/dds.h>
+#include <regex.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <mutex>
+
+#include "auvrl_message.h"
+
+namespace auvrl::transport {
+
+namespace {
+
+using channels::ChannelClass;
+
+constexpr std::array<ChannelClass, 4> kAllClasses = {ChannelClass::kState, ChannelClass::kQueue,
+                                                     ChannelClass::kLockstep, ChannelClass::kOther};
+
+/// Depth of the writers' keep-last histories (what a reliable writer can resend).
+constexpr int kLockstepWriterDepth = 8;
+constexpr int kOtherWriterDepth = 16;
+/// A state-class or other publish that cannot go out within this long fails.
+constexpr std::chrono::milliseconds kDefaultMaxBlocking{1000};
+
+std::string dds_error(dds_return_t rc) { return dds_strretcode(rc); }
+
+bool is_loopback_peer(const std::string& peer) {
+  return peer.rfind("127.", 0) == 0 || peer == "localhost" || peer == "::1" || peer == "[::1]" ||
+         peer.rfind("localhost:", 0) == 0 || peer.rfind("[::1]:", 0) == 0;
+}
+
+/// Domains this process has created, shared by every transport in the same domain (Cyclone
+/// allows one configuration per domain and process; deleting the domain ends its participants).
+struct DomainEntry {
+  dds_entity_t domain = 0;
+  std::string config;
+  int users = 0;
+};
+std::mutex g_domains_mutex;
+std::map<int, DomainEntry> g_domains;
+
+void acquire_domain(int domain_id, const std::string& config) {
+  std::lock_guard<std::mutex> lock(g_domains_mutex);
+  const auto it = g_domains.find(domain_id);
+  if (it != g_domains.end()) {
+    if (it->second.config != config) {
+      throw TransportError("DDS domain " + std::to_string(domain_id) +
+                           " is already open in this process with another configuration");
+    }
+    ++it->second.users;
+    return;
+  }
+  const dds_entity_t domain =
+      dds_create_domain(static_cast<dds_domainid_t>(domain_id), config.c_str());
+  if (domain < 0) {
+    throw TransportError("cannot create DDS domain " + std::to_string(domain_id) + " (" +
+                         dds_error(domain) +
+                         "); check the Cyclone configuration: " + config.substr(0, 300));
+  }
+  g_domains[domain_id] = {domain, config, 1};
+}
+
+void release_domain(int domain_id) {
+  std::lock_guard<std::mutex> lock(g_domains_mutex);
+  const auto it = g_domains.find(domain_id);
+  if (it == g_domains.end()) return;
+  if (--it->second.users == 0) {
+    dds_delete(it->second.domain);
+    g_domains.erase(it);
+  }
+}
+
+/// A dds_qos_t that frees itself.
+class Qos {
+ public:
+  Qos() : qos_(dds_create_qos()) {}
+  ~Qos() { dds_delete_qos(qos_); }
+  Qos(const Qos&) = delete;
+  Qos& operator=(const Qos&) = delete;
+  dds_qos_t* get() const { return qos_; }
+
+ private:
+  dds_qos_t* qos_;
+};
+
+dds_duration_t to_dds(std::chrono::milliseconds ms) { return DDS_MSECS(ms.count()); }
+
+void set_writer_qos(const Qos& q, ChannelClass c, bool lockstep_reliable) {
+  switch (c) {
+    case ChannelClass::kState:
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+      break;
+    case ChannelClass::kQueue:
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDdsQueueMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_ALL, 0);
+      break;
+    case ChannelClass::kLockstep:
+      dds_qset_reliability(
+          q.get(), lockstep_reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+          to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, kLockstepWriterDepth);
+      break;
+    case ChannelClass::kOther:
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, kOtherWriterDepth);
+      break;
+  }
+}
+
+void set_reader_qos(const Qos& q, ChannelClass c, bool lockstep_reliable, int queue_capacity) {
+  const int depth = std::max(1, queue_capacity);
+  switch (c) {
+    case ChannelClass::kState:
+      // Only the newest per channel: a reader that falls behind skips versions.
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
+      dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+      break;
+    case ChannelClass::kQueue:
+      // A full history rejects new samples; the reliable protocol then holds them at the
+      // writer, which waits: back-pressure, not loss.
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDdsQueueMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_ALL, 0);
+      dds_qset_resource_limits(q.get(), depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+      break;
+    case ChannelClass::kLockstep:
+      dds_qset_reliability(
+          q.get(), lockstep_reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+          to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+      break;
+    case ChannelClass::kOther:
+      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+      break;
+  }
+}
+
+/// The Cyclone DDS implementation of Transport (one participant, one waitset, one thread).
+class DdsTransport final : public Transport {
+ public:
+  DdsTransport(const DdsSettings& settings, const std::string& config)
+      : domain_id_(settings.domain_id), lockstep_reliable_(settings.lockstep_reliable) {
+    acquire_domain(domain_id_, config);
+    participant_ =
+        dds_create_participant(static_cast<dds_domainid_t>(domain_id_), nullptr, nullptr);
+    if (participant_ < 0) {
+      release_domain(domain_id_);
+      throw TransportError("cannot create a DDS participant in domain " +
+                           std::to_string(domain_id_) + ": " + dds_error(participant_));
+    }
+    try {
+      waitset_ = check(dds_create_waitset(participant_), "create a waitset");
+      // Writers of every class from the start: discovery then matches them with the readers
+      // long before the first publish, so no first message goes to nobody.
+      for (ChannelClass c : kAllClasses) {
+        const dds_entity_t topic = create_topic(c);
+        Qos qos;
+        set_writer_qos(qos, c, lockstep_reliable_);
+        writers_[index(c)] =
+            check(dds_create_writer(participant_, topic, qos.get(), nullptr), "create a writer");
+      }
+    } catch (...) {
+      dds_delete(participant_);
+      release_domain(domain_id_);
+      throw;
+    }
+  }
+
+  ~DdsTransport() override {
+    dds_delete(participant_);  // and every reader, writer, topic and the waitset in it
+    subscriptions_.clear();
+    release_domain(domain_id_);
+  }
+
+  void publish(const std::string& channel, const void* data, std::size_t size) override {
+    if (size > UINT32_MAX) {
+      throw TransportError("DDS publish refused on channel " + channel + ": " +
+                           std::to_string(size) + " bytes is too large");
+    }
+    auvrl_dds_Message msg{};
+    msg.channel = const_cast<char*>(channel.c_str());
+    msg.data._buffer = static_cast<std::uint8_t*>(const_cast<void*>(data));
+    msg.data._length = static_cast<std::uint32_t>(size);
+    msg.data._maximum = static_cast<std::uint32_t>(size);
+    msg.data._release = false;
+    const dds_return_t rc = dds_write(writers_[index(channels::channel_class(channel))], &msg);
+    if (rc == DDS_RETCODE_TIMEOUT) {
+      throw TransportError("DDS publish on channel " + channel + " (" + std::to_string(size) +
+                           " bytes) timed out: a reader does not keep up (back-pressure)");
+    }
+    if (rc < 0) {
+      throw TransportError("DDS publish failed on channel " + channel + " (" +
+                           std::to_string(size) + " bytes): " + dds_error(rc));
+    }
+  }
+
+  SubscriptionId subscribe(const std::string& channel_regex, RawHandler handler,
+                           int queue_capacity) override {
+    auto sub = std::make_unique<Subscription>();
+    sub->handler = std::move(handler);
+    const std::string anchored = "^(" + channel_regex + ")$";
+    if (regcomp(&sub->regex, anchored.c_str(), REG_EXTENDED | REG_NOSUB) != 0) {
+      throw TransportError("DDS cannot subscribe to '" + channel_regex +
+                           "': not a POSIX extended regular expression");
+    }
+    sub->regex_ok = true;
+    const SubscriptionId id = next_id_++;
+    try {
+      for (ChannelClass c : classes_possibly_matching(channel_regex)) {
+        // A topic entity of its own, so that the filter (this subscription's regex) applies
+        // to this reader only.
+        const dds_entity_t topic = create_topic(c);
+        check(dds_set_topic_filter_and_arg(topic, &Subscription::accept, sub.get()),
+              "set a topic filter");
+        Qos qos;
+        set_reader_qos(qos, c, lockstep_reliable_, queue_capacity);
+        const dds_entity_t reader =
+            check(dds_create_reader(participant_, topic, qos.get(), nullptr), "create a reader");
+        sub->entities.push_back(reader);
+        sub->entities.push_back(topic);
+        const dds_entity_t condition =
+            check(dds_create_readcondition(reader, DDS_ANY_STATE), "create a read condition");
+        check(dds_waitset_attach(waitset_, condition, static_cast<dds_attach_t>(reader)),
+              "attach a read condition");
+        sub->readers.push_back(reader);
+      }
+    } catch (...) {
+      for (dds_entity_t e : sub->entities) dds_delete(e);
+      throw;
+    }
+    subscriptions_.emplace(id, std::move(sub));
+    rebuild_reader_list();
+    return id;
+  }
+
+  void unsubscribe(SubscriptionId id) override {
+    const auto it = subscriptions_.find(id);
+    if (it == subscriptions_.end()) return;
+    if (dispatching_) {
+      // The handler running now may hold a loan from one of these readers: end it after.
+      it->second->removed = true;
+      pending_removal_.push_back(id);
+      return;
+    }
+    remove(it);
+  }
+
+  bool handle_one(int timeout_ms) override {
+    if (take_one()) return true;
+    if (timeout_ms == 0) return false;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+    while (true) {
+      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(
+          deadline - std::chrono::steady_clock::now());
+      if (timeout_ms > 0 && left.count() <= 0) return false;
+      const dds_return_t rc =
+          dds_waitset_wait(waitset_, nullptr, 0, timeout_ms < 0 ? DDS_INFINITY : left.count());
+      if (rc < 0) throw TransportError("DDS wait failed: " + dds_error(rc));
+      if (take_one()) return true;
+      if (rc == 0 && timeout_ms > 0) return false;
+    }
+  }
+
+ private:
+  struct Subscription {
+    regex_t regex{};
+    bool regex_ok = false;
+    bool removed = false;
+    RawHandler handler;
+    std::vector<dds_entity_t> readers;
+    std::vector<dds_entity_t> entities;  ///< readers and their topic entities
+    ~Subscription() {
+      if (regex_ok) regfree(&regex);
+    }
+    /// Reader-side filter, called on Cyclone's receive threads (regexec is thread-safe).
+    static bool accept(const void* sample, void* arg) {
+      const auto* msg = static_cast<const auvrl_dds_Message*>(sample);
+      const auto* self = static_cast<const Subscription*>(arg);
+      return msg->channel != nullptr && regexec(&self->regex, msg->channel, 0, nullptr, 0) == 0;
+    }
+  };
+
+  static std::size_t index(ChannelClass c) { return static_cast<std::size_t>(c); }
+
+  dds_entity_t check(dds_entity_t rc, const char* what) const {
+    if (rc < 0) {
+      throw TransportError(std::string("DDS cannot ") + what + " in domain " +
+                           std::to_string(domain_id_) + ": " + dds_error(rc));
+    }
+    return rc;
+  }
+
+  dds_entity_t create_topic(ChannelClass c) {
+    return check(dds_create_topic(participant_, &auvrl_dds_Message_desc, dds_topic_name(c), nullptr,
+                                  nullptr),
+                 "create a topic");
+  }
+
+  void remove(std::map<SubscriptionId, std::unique_ptr<Subscription>>::iterator it) {
+    for (dds_entity_t e : it->second->entities) dds_delete(e);
+    subscriptions_.erase(it);
+    rebuild_reader_list();
+  }
+
+  void rebuild_reader_list() {
+    readers_.clear();
+    for (const auto& [id, sub] : subscriptions_) {
+      if (sub->removed) continue;
+      for (dds_entity_t r : sub->readers) readers_.push_back({id, r});
+    }
+    if (next_reader_ >= readers_.size()) next_reader_ = 0;
+  }
+
+  /// Takes one valid sample from the readers (round robin, so a busy channel cannot starve
+  /// the others) and dispatches it. False if none had one.
+  bool take_one() {
+    const std::size_t n = readers_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t i = (next_reader_ + k) % n;
+      const auto [id, reader] = readers_[i];
+      while (true) {
+        void* sample = nullptr;
+        dds_sample_info_t info;
+        const dds_return_t got = dds_take(reader, &sample, &info, 1, 1);
+        if (got < 0) throw TransportError("DDS take failed: " + dds_error(got));
+        if (got == 0) break;
+        if (!info.valid_data) {  // a writer went away or disposed: no message
+          dds_return_loan(reader, &sample, got);
+          continue;
+        }
+        next_reader_ = (i + 1) % n;
+        dispatch(id, reader, sample);
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void dispatch(SubscriptionId id, dds_entity_t reader, void* sample) {
+    struct Loan {
+      dds_entity_t reader;
+      void* sample;
+      ~Loan() { dds_return_loan(reader, &sample, 1); }
+    } loan{reader, sample};
+    const auto* msg = static_cast<const auvrl_dds_Message*>(sample);
+    const auto it = subscriptions_.find(id);
+    if (it == subscriptions_.end() || it->second->removed) return;
+    const std::string channel(msg->channel != nullptr ? msg->channel : "");
+    const RawMessage raw{channel, msg->data._buffer, msg->data._length, now_utime()};
+    dispatching_ = true;
+    struct Done {
+      DdsTransport& self;
+      ~Done() {
+        self.dispatching_ = false;
+        auto pending = std::move(self.pending_removal_);
+        self.pending_removal_.clear();
+        for (SubscriptionId removed : pending) {
+          const auto found = self.subscriptions_.find(removed);
+          if (found != self.subscriptions_.end()) self.remove(found);
+        }
+      }
+    };
+    {
+      Done done{*this};
+      it->second->handler(raw);
+    }
+  }
+
+  int domain_id_;
+  bool lockstep_reliable_;
+  dds_entity_t participant_ = 0;
+  dds_entity_t waitset_ = 0;
+  std::array<dds_entity_t, 4> writers_{};
+  std::map<SubscriptionId, std::unique_ptr<Subscription>> subscriptions_;
+  std::vector<std::pair<SubscriptionId, dds_entity_t>> readers_;
+  std::size_t next_reader_ = 0;
+  SubscriptionId next_id_ = 0;
+  bool dispatching_ = false;
+  std::vector<SubscriptionId> pending_removal_;
+};
+
+}  // namespace
+
+const char* dds_topic_name(ChannelClass channel_class) {
+  switch (channel_class) {
+    case ChannelClass::kState:
+      return "auvrl_state";
+    case ChannelClass::kQueue:
+      return "auvrl_queue";
+    case ChannelClass::kLockstep:
+      return "auvrl_lockstep";
+    case ChannelClass::kOther:
+      break;
+  }
+  return "auvrl_other";
+}
+
+std::vector<ChannelClass> classes_possibly_matching(const std::string& channel_regex) {
+  // The literal prefix every match must start with: the characters before the first one
+  // that is special in an extended regex; none at all if there is an alternation.
+  std::string prefix;
+  if (channel_regex.find('|') == std::string::npos) {
+    const std::string special = ".[]()*+?{}|^$\\";
+    std::size_t end = 0;
+    while (end < channel_regex.size() && special.find(channel_regex[end]) == std::string::npos) {
+      ++end;
+    }
+    prefix = channel_regex.substr(0, end);
+    // "AB*" or "AB?" or "AB{0,1}": the B is optional.
+    if (end < channel_regex.size() && !prefix.empty() &&
+        std::string("*?{").find(channel_regex[end]) != std::string::npos) {
+      prefix.pop_back();
+    }
+  }
+  std::vector<ChannelClass> out;
+  bool prefix_fixes_class = false;
+  for (ChannelClass c : kAllClasses) {
+    if (c == ChannelClass::kOther) continue;
+    bool possible = false;
+    for (const channels::ChannelClassPrefix& p : channels::kChannelClassPrefixes) {
+      if (p.channel_class != c) continue;
+      const std::string class_prefix = p.prefix;
+      if (class_prefix.rfind(prefix, 0) == 0) possible = true;
+      if (prefix.rfind(class_prefix, 0) == 0) possible = prefix_fixes_class = true;
+    }
+    if (possible) out.push_back(c);
+  }
+  // Channels of no listed prefix are kOther: possible unless the prefix already begins with a
+  // class's prefix.
+  if (!prefix_fixes_class) out.push_back(ChannelClass::kOther);
+  return out;
+}
+
+void check_dds_settings(const DdsSettings& s, bool allow_off_host) {
+  if (s.domain_id < 0 || s.domain_id > 232) {
+    throw TransportError("DDS domain id " + std::to_string(s.domain_id) +
+                         " is out of range (0..232)");
+  }
+  if (s.max_auto_participant_index < 1) {
+    throw TransportError("DDS max_auto_participant_index must be >= 1");
+  }
+  if (!s.config_path.empty()) {
+    if (access(s.config_path.c_str(), R_OK) != 0) {
+      throw TransportError("DDS configuration file '" + s.config_path + "' cannot be read");
+    }
+    if (!allow_off_host) {
+      throw TransportError("refusing DDS configuration file '" + s.config_path +
+                           "': it may bind interfaces that leave this host, and DDS here has "
+                           "no authentication; pass --allow-off-host to accept it");
+    }
+    return;
+  }
+  if (s.peers.empty()) throw TransportError("DDS needs at least one peer (e.g. 127.0.0.1)");
+  for (const std::string& peer : s.peers) {
+    if (peer.empty() || peer.find_first_of("<>&\"' \t\n") != std::string::npos) {
+      throw TransportError("DDS peer '" + peer + "' is not a host name or address");
+    }
+    if (!is_loopback_peer(peer) && !allow_off_host) {
+      throw TransportError("refusing DDS peer '" + peer +
+                           "': traffic to it leaves this host, and DDS here has no "
+                           "authentication; pass --allow-off-host to accept it");
+    }
+  }
+}
+
+std::string dds_default_config_xml(const DdsSettings& s) {
+  bool all_loopback = true;
+  for (const std::string& peer : s.peers) all_loopback = all_loopback && is_loopback_peer(peer);
+  std::string xml = "<CycloneDDS><Domain id=\"any\"><General>";
+  // Off-host peers: Cyclone picks the interface that reaches them.
+  if (all_loopback) xml += "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>";
+  xml += "<AllowMulticast>false</AllowMulticast></General><Discovery><Peers>";
+  for (const std::string& peer : s.peers) xml += "<Peer address=\"" + peer + "\"/>";
+  xml += "</Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
+         std::to_string(s.max_auto_participant_index) +
+         "</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
+  return xml;
+}
+
+std::unique_ptr<Transport> make_dds_transport(const DdsSettings& settings, bool allow_off_host) {
+  check_dds_settings(settings, allow_off_host);
+  const std::string config = settings.config_path.empty() ? dds_default_config_xml(settings)
+                                                          : "file://" + settings.config_path;
+  return std::make_unique<DdsTransport>(settings, config);
+}
+
+}  // namespace auvrl::transport
