@@ -9,6 +9,7 @@
 #include "agent/actor_node.hpp"
 #include "common/cli.hpp"
 #include "common/signals.hpp"
+#include "common/transport_options.hpp"
 
 int main(int argc, char** argv) {
   using namespace auvrl;
@@ -56,12 +57,9 @@ int main(int argc, char** argv) {
   cmd.option("max-episodes", &config.max_episodes, "stop after this many (0: until stopped)");
   cmd.option("pin-cpu", &pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &report_every, "a log line every N episodes");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL of the system's bus");
-  std::string lockstep_url;
-  cmd.option("lockstep-lcm-url", &lockstep_url,
-             "the bus shared with its simulator only (default: the system's bus)");
-  cmd.flag("allow-off-host", &transport_config.allow_off_host,
-           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  transport::add_transport_options(cmd, transport_config);
+  transport::LockstepBusOptions lockstep_bus;
+  transport::add_lockstep_options(cmd, lockstep_bus);
   try {
     if (!cmd.parse(argc, argv)) return 0;
     config.task.layout = task::parse_layout(layout);
@@ -86,10 +84,9 @@ int main(int argc, char** argv) {
 
   try {
     auto transport = transport::make_transport(transport_config);
+    const auto lockstep_config = transport::lockstep_bus_config(transport_config, lockstep_bus);
     std::unique_ptr<transport::Transport> lockstep;
-    if (!lockstep_url.empty()) {
-      lockstep = transport::make_transport({lockstep_url, transport_config.allow_off_host});
-    }
+    if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
     signals::install_stop_handlers();
     agent::ActorNode node(config, *transport, std::cerr, lockstep.get());
     std::cerr << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "

@@ -13,6 +13,7 @@
 #include "agent/evaluation.hpp"
 #include "agent/launcher.hpp"
 #include "common/cli.hpp"
+#include "common/transport_options.hpp"
 
 namespace {
 
@@ -67,7 +68,8 @@ int run_train(int argc, const char* const* argv) {
   auvrl::cli::CommandLine cli(
       "auvrl train",
       "Trains a policy with the whole system (auv_sim per actor, N auv_actor, auv_learner,\n"
-      "auv_logger) in a private network namespace, shows progress, restarts crashed processes,\n"
+      "auv_logger; over LCM or DDS: transport: in the configuration, or --transport) in a\n"
+      "private network namespace, shows progress, restarts crashed processes,\n"
       "stops cleanly on Ctrl-C, then evaluates the policy and the PID baseline, draws the plots\n"
       "and writes RUN/report.md.");
   cli.option("preset", &preset, "config/presets/NAME.yaml (paper or fast)");
@@ -81,6 +83,9 @@ int run_train(int argc, const char* const* argv) {
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
   cli.option("network", &network,
              "private (default: own network namespace) or host (LCM on the host's network)");
+  // Over the configuration's transport: section; recorded and passed to every process.
+  auvrl::transport::TransportConfig cli_transport;
+  auvrl::transport::add_transport_options(cli, cli_transport, &options.transport_args);
   if (!cli.parse(argc, argv)) return 0;
   if (network != "private" && network != "host") {
     throw auvrl::cli::UsageError("option --network: expected private or host");
@@ -110,6 +115,7 @@ int run_train(int argc, const char* const* argv) {
   }
   if (options.seed >= 0) args.insert(args.end(), {"--seed", std::to_string(options.seed)});
   if (no_eval) args.push_back("--no-eval");
+  args.insert(args.end(), options.transport_args.begin(), options.transport_args.end());
   setenv("AUVRL_IN_NETNS", "1", 1);
   std::vector<char*> cargs;
   for (auto& a : args) cargs.push_back(a.data());

@@ -27,6 +27,7 @@
 #include "common/signals.hpp"
 #include "common/task/task_yaml.hpp"
 #include "common/transport.hpp"
+#include "common/transport_options.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace auvrl::agent {
@@ -42,6 +43,7 @@ struct RunConfig {
   task::TaskConfig task;
   std::string vehicle_path;
   std::int64_t learner_max_episodes = 0;
+  transport::TransportConfig transport;  ///< the `transport:` section (LCM by default)
 };
 
 RunConfig read_run_config(const std::string& path) {
@@ -64,6 +66,7 @@ RunConfig read_run_config(const std::string& path) {
   run.read("max_restarts", c.run.max_restarts);
   run.read("restart_window_s", c.run.restart_window_s);
   run.finish();
+  transport::read_transport_section(root.child("transport"), c.transport);
   return c;
 }
 
@@ -217,8 +220,18 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   }
   const bool has_checkpoint = !fs::is_empty(run_dir / "checkpoints");
 
+  transport::apply_transport_arguments(options.transport_args, rc.transport);
+  // Every process opens the same transport as the launcher.
+  const std::vector<std::string> transport_args = transport::transport_arguments(rc.transport);
+  const bool dds = rc.transport.kind == transport::TransportKind::kDds;
+  if (dds && rc.run.private_lockstep_bus && rc.transport.dds.domain_id + actors > 232) {
+    throw std::runtime_error("DDS domain " + std::to_string(rc.transport.dds.domain_id) +
+                             " + one lockstep domain per actor (" + std::to_string(actors) +
+                             ") passes 232: choose a lower transport.dds_domain");
+  }
+
   signals::install_stop_handlers();
-  auto transport = transport::make_transport({});
+  auto transport = transport::make_transport(rc.transport);
 
   // ---- What the run writes while it trains. ----
   const bool new_files = !fs::exists(run_dir / "episodes.csv");
@@ -287,8 +300,12 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     roles.push_back(std::move(role));
     return roles.back().get();
   };
-  const auto fixed = [](std::vector<std::string> argv) {
-    return [argv](std::size_t) { return argv; };
+  const auto with_transport = [transport_args](std::vector<std::string> argv) {
+    argv.insert(argv.end(), transport_args.begin(), transport_args.end());
+    return argv;
+  };
+  const auto fixed = [with_transport](std::vector<std::string> argv) {
+    return [argv = with_transport(std::move(argv))](std::size_t) { return argv; };
   };
   Role* logger =
       add_role("logger", fixed({bin + "auv_logger", "--dir", (run_dir / "logs").string()}));
@@ -298,8 +315,14 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   for (int c = 0; c < cpus; ++c) {
     if (c != rc.run.learner_cpu || cpus == 1) actor_cpus.push_back(c);
   }
-  const auto lockstep_url = [&](int i) {
-    return "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576";
+  // The private lockstep bus of pair i: an LCM port, or a DDS domain, of its own.
+  const auto lockstep_args = [&](int i) -> std::vector<std::string> {
+    if (!rc.run.private_lockstep_bus) return {};
+    if (dds) {
+      return {"--lockstep-dds-domain", std::to_string(rc.transport.dds.domain_id + 1 + i)};
+    }
+    return {"--lockstep-lcm-url",
+            "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576"};
   };
   for (int i = 0; i < actors; ++i) {
     const std::string cpu =
@@ -307,8 +330,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     std::vector<std::string> argv = {
         "/usr/bin/taskset", "-c",         cpu, bin + "auv_sim",      "--vehicle",
         rc.vehicle_path,    "--vehicles", "1", "--first-vehicle-id", std::to_string(i)};
-    if (rc.run.private_lockstep_bus)
-      argv.insert(argv.end(), {"--lockstep-lcm-url", lockstep_url(i)});
+    const auto bus = lockstep_args(i);
+    argv.insert(argv.end(), bus.begin(), bus.end());
     sims.push_back(add_role("sim" + std::to_string(i), fixed(argv)));
   }
   std::vector<std::string> learner_argv = {bin + "auv_learner", "--config", config_path,
@@ -326,8 +349,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   for (int i = 0; i < actors; ++i) {
     const std::uint64_t seed = rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
     const int cpu = actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()];
-    const bool private_bus = rc.run.private_lockstep_bus;
-    const std::string url = lockstep_url(i);
+    const std::vector<std::string> bus = lockstep_args(i);
     actor_roles.push_back(add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
       // A restarted actor explores anew rather than repeating its first life.
       std::vector<std::string> argv = {bin + "auv_actor",
@@ -343,8 +365,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                                        std::to_string(cpu),
                                        "--report-every",
                                        "100"};
-      if (private_bus) argv.insert(argv.end(), {"--lockstep-lcm-url", url});
-      return argv;
+      argv.insert(argv.end(), bus.begin(), bus.end());
+      return with_transport(argv);
     }));
   }
   const auto start_role = [&](Role& r, bool resume_learner) {
@@ -358,7 +380,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   for (Role* s : sims) start_role(*s, false);
   start_role(*learner, has_checkpoint);
   for (Role* a : actor_roles) start_role(*a, false);
-  out << "auvrl train: " << actors << " actors on " << cpus << " CPUs, run " << run_dir.string()
+  out << "auvrl train: " << actors << " actors on " << cpus << " CPUs, "
+      << transport::describe(rc.transport) << ", run " << run_dir.string()
       << "\n  watch it: scripts/spy.sh " << run_dir.string() << "\n";
 
   // ---- Supervise, show progress, keep the best policy. ----

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace auvrl::agent {
 
@@ -39,6 +40,9 @@ struct TrainOptions {
   bool evaluate = true;     ///< evaluation, plots and report after training
   std::string bin_dir;      ///< where auv_sim, auv_actor, auv_learner, auv_logger are
   std::string source_dir;   ///< the source tree (scripts/ for plots)
+  /// Transport flags given on the command line (--transport dds, --dds-peers ...): applied
+  /// over the configuration's `transport:` section and passed to every process.
+  std::vector<std::string> transport_args;
 };
 
 /// Creates the run directory of a new run (config copy, folders) or checks an existing one for

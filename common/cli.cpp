@@ -63,6 +63,25 @@ void CommandLine::option(const std::string& name, double* target, const std::str
        }});
 }
 
+void CommandLine::custom_flag(const std::string& name, std::function<void()> set,
+                              const std::string& help) {
+  add({name, help, "", false, [set = std::move(set)](const std::string&) { set(); }});
+}
+
+void CommandLine::custom_option(const std::string& name,
+                                std::function<void(const std::string&)> parse,
+                                const std::string& default_text, const std::string& help) {
+  add({name, help, default_text, true, [parse = std::move(parse), name](const std::string& v) {
+         try {
+           parse(v);
+         } catch (const UsageError&) {
+           throw;
+         } catch (const std::exception& e) {
+           throw UsageError("option --" + name + ": " + e.what());
+         }
+       }});
+}
+
 bool CommandLine::parse(int argc, const char* const* argv) {
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];

@@ -28,6 +28,12 @@ class CommandLine {
   void option(const std::string& name, int* target, const std::string& help);
   void option(const std::string& name, std::int64_t* target, const std::string& help);
   void option(const std::string& name, double* target, const std::string& help);
+  /// --name (no value) calls set.
+  void custom_flag(const std::string& name, std::function<void()> set, const std::string& help);
+  /// --name VALUE handed to parse, which converts, checks and stores it; an exception it
+  /// throws becomes a UsageError naming the option. default_text is shown in --help.
+  void custom_option(const std::string& name, std::function<void(const std::string&)> parse,
+                     const std::string& default_text, const std::string& help);
 
   /// Parses argv. Returns false when --help was given (usage printed to stdout); throws
   /// UsageError on an unknown option, a missing or malformed value.

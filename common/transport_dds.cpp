@@ -4,6 +4,7 @@
 #include <regex.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -402,39 +403,102 @@ const char* dds_topic_name(ChannelClass channel_class) {
   return "auvrl_other";
 }
 
-std::vector<ChannelClass> classes_possibly_matching(const std::string& channel_regex) {
-  // The literal prefix every match must start with: the characters before the first one
-  // that is special in an extended regex; none at all if there is an alternation.
-  std::string prefix;
-  if (channel_regex.find('|') == std::string::npos) {
-    const std::string special = ".[]()*+?{}|^$\\";
-    std::size_t end = 0;
-    while (end < channel_regex.size() && special.find(channel_regex[end]) == std::string::npos) {
-      ++end;
+namespace {
+
+/// The top-level alternatives of a regex ("A|(B|C)" -> "A", "(B|C)"), with one pair of
+/// parentheses around the whole regex removed first; escapes and bracket expressions are
+/// skipped over.
+std::vector<std::string> top_level_alternatives(std::string regex) {
+  const auto split = [](const std::string& r, bool* wrapped) {
+    std::vector<std::string> parts;
+    int depth = 0;
+    bool in_bracket = false;
+    std::size_t start = 0;
+    *wrapped = r.size() >= 2 && r.front() == '(' && r.back() == ')';
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      const char c = r[i];
+      if (in_bracket) {
+        // "[]...]" and "[^]...]": a ']' first in the bracket is literal.
+        if (c == ']' && i > 0 && r[i - 1] != '[' && !(r[i - 1] == '^' && r[i - 2] == '[')) {
+          in_bracket = false;
+        }
+        continue;
+      }
+      if (c == '\\') {
+        ++i;
+      } else if (c == '[') {
+        in_bracket = true;
+      } else if (c == '(') {
+        ++depth;
+      } else if (c == ')') {
+        // The opening parenthesis closes before the end: not one group around everything.
+        if (--depth == 0 && i + 1 < r.size()) *wrapped = false;
+      } else if (c == '|' && depth == 0) {
+        parts.push_back(r.substr(start, i - start));
+        start = i + 1;
+      }
     }
-    prefix = channel_regex.substr(0, end);
-    // "AB*" or "AB?" or "AB{0,1}": the B is optional.
-    if (end < channel_regex.size() && !prefix.empty() &&
-        std::string("*?{").find(channel_regex[end]) != std::string::npos) {
-      prefix.pop_back();
-    }
+    parts.push_back(r.substr(start));
+    return parts;
+  };
+  bool wrapped = false;
+  auto parts = split(regex, &wrapped);
+  while (parts.size() == 1 && wrapped) {
+    regex = regex.substr(1, regex.size() - 2);
+    parts = split(regex, &wrapped);
   }
-  std::vector<ChannelClass> out;
+  return parts;
+}
+
+/// The classes one alternative (no top-level '|') may match, from its literal prefix.
+void add_classes_of_branch(const std::string& branch, std::vector<bool>& possible) {
+  // The literal prefix every match must start with: the characters before the first one
+  // that is special in an extended regex.
+  const std::string special = ".[]()*+?{}|^$\\";
+  std::size_t end = 0;
+  while (end < branch.size() && special.find(branch[end]) == std::string::npos) ++end;
+  std::string prefix = branch.substr(0, end);
+  // "AB*" or "AB?" or "AB{0,1}": the B is optional.
+  if (end < branch.size() && !prefix.empty() &&
+      std::string("*?{").find(branch[end]) != std::string::npos) {
+    prefix.pop_back();
+  }
   bool prefix_fixes_class = false;
-  for (ChannelClass c : kAllClasses) {
-    if (c == ChannelClass::kOther) continue;
-    bool possible = false;
-    for (const channels::ChannelClassPrefix& p : channels::kChannelClassPrefixes) {
-      if (p.channel_class != c) continue;
-      const std::string class_prefix = p.prefix;
-      if (class_prefix.rfind(prefix, 0) == 0) possible = true;
-      if (prefix.rfind(class_prefix, 0) == 0) possible = prefix_fixes_class = true;
+  for (const channels::ChannelClassPrefix& p : channels::kChannelClassPrefixes) {
+    const std::string class_prefix = p.prefix;
+    const bool longer = prefix.rfind(class_prefix, 0) == 0;
+    if (longer || class_prefix.rfind(prefix, 0) == 0) {
+      possible[static_cast<std::size_t>(p.channel_class)] = true;
     }
-    if (possible) out.push_back(c);
+    prefix_fixes_class = prefix_fixes_class || longer;
   }
   // Channels of no listed prefix are kOther: possible unless the prefix already begins with a
   // class's prefix.
-  if (!prefix_fixes_class) out.push_back(ChannelClass::kOther);
+  if (!prefix_fixes_class) possible[static_cast<std::size_t>(ChannelClass::kOther)] = true;
+}
+
+/// Marks the classes a regex may match in possible (alternatives analysed one by one).
+void add_classes(const std::string& regex, std::vector<bool>& possible) {
+  const std::vector<std::string> parts = top_level_alternatives(regex);
+  if (parts.size() > 1) {
+    for (const std::string& part : parts) add_classes(part, possible);
+  } else if (parts[0].find('|') != std::string::npos) {
+    // A nested alternation ("A(B|C)"): not analysed, every class is possible.
+    std::fill(possible.begin(), possible.end(), true);
+  } else {
+    add_classes_of_branch(parts[0], possible);
+  }
+}
+
+}  // namespace
+
+std::vector<ChannelClass> classes_possibly_matching(const std::string& channel_regex) {
+  std::vector<bool> possible(kAllClasses.size(), false);
+  add_classes(channel_regex, possible);
+  std::vector<ChannelClass> out;
+  for (ChannelClass c : kAllClasses) {
+    if (possible[static_cast<std::size_t>(c)]) out.push_back(c);
+  }
   return out;
 }
 

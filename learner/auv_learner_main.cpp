@@ -6,6 +6,7 @@
 #include "common/cli.hpp"
 #include "common/nn/mlp.hpp"
 #include "common/signals.hpp"
+#include "common/transport_options.hpp"
 #include "learner/bench.hpp"
 #include "learner/learner_config.hpp"
 #include "learner/learner_node.hpp"
@@ -101,9 +102,7 @@ int main(int argc, char** argv) {
   cmd.flag("resume", &resume, "continue from the newest usable checkpoint in --checkpoint-dir");
   cmd.flag("keep-running", &keep_running, "keep serving after training is done");
   cmd.option("threads", &threads, "threads for the matrix products");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
-  cmd.flag("allow-off-host", &transport_config.allow_off_host,
-           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  transport::add_transport_options(cmd, transport_config);
   cmd.flag("bench", &bench,
            "print updates/s for 64-64 batch 100, 256-256 batch 256, 400-300 batch 64 (or the one "
            "case --hidden/--batch give) and exit");
@@ -148,8 +147,8 @@ int main(int argc, char** argv) {
     learner::LearnerNode node(config, *transport, std::cerr);
     if (resume) node.resume();
     std::cerr << "auv_learner: " << algo << ", actor " << node.algorithm().actor().spec().describe()
-              << ", buffer " << config.ddpg.replay_capacity << ", " << transport_config.lcm_url
-              << "\n";
+              << ", buffer " << config.ddpg.replay_capacity << ", "
+              << transport::describe(transport_config) << "\n";
     bool announced_done = false;
     while (!signals::stop_requested()) {
       node.poll(50);

@@ -6,6 +6,7 @@
 
 #include "common/signals.hpp"
 #include "common/transport.hpp"
+#include "common/transport_options.hpp"
 #include "logger/command_line.hpp"
 #include "logger/logger.hpp"
 #include "logger/schema.hpp"
@@ -19,7 +20,8 @@ int main(int argc, char** argv) {
 
   logger::ToolCommandLine cmd(
       "auv_logger",
-      "Writes the LCM traffic (every channel, or those matching --channels) into LCM event logs "
+      "Writes the traffic of the transport (LCM or DDS; every channel, or those matching "
+      "--channels) into LCM event logs "
       "(lcm-logger's format) in --dir, rotating by size, and publishes counts on " +
           channels::kLoggerHeartbeat + ".");
   cmd.option("dir", &config.dir, "directory of the log files (created if missing)");
@@ -32,10 +34,9 @@ int main(int argc, char** argv) {
                  "REGEX=SECONDS: log those channels at most once per interval (built in: " +
                      logger::kDefaultPolicyThrottle.pattern + "=10; =0 turns a rule off)");
   cmd.option("types-dir", &types_dir, "directory of the .lcm files (names types in the summary)");
-  cmd.option("queue-capacity", &config.queue_capacity, "messages LCM may hold between polls");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
-  cmd.flag("allow-off-host", &transport_config.allow_off_host,
-           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  cmd.option("queue-capacity", &config.queue_capacity,
+             "messages the transport may hold between polls");
+  transport::add_transport_options(cmd, transport_config);
   try {
     if (!cmd.parse(argc, argv)) return 0;
     if (!cmd.positional().empty()) {
@@ -65,7 +66,7 @@ int main(int argc, char** argv) {
     signals::install_stop_handlers();
     logger::Logger logger(*transport, config);
     std::cerr << "auv_logger: logging '" << config.channels << "' into " << config.dir << " ("
-              << transport_config.lcm_url << ")\n";
+              << transport::describe(transport_config) << ")\n";
     while (!signals::stop_requested()) logger.poll(50);
     const std::string summary = logger.finish(schema.get());
     std::cerr << "auv_logger: stopped: received " << logger.received() << ", written "

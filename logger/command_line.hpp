@@ -3,6 +3,7 @@
 // rest goes to CommandLine, which keeps the typing, the errors and --help.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
@@ -22,6 +23,16 @@ class ToolCommandLine {
   template <class T>
   void option(const std::string& name, T* target, const std::string& help) {
     command_line_.option(name, target, help);
+    value_options_.insert(name);
+  }
+  /// As cli::CommandLine::custom_flag.
+  void custom_flag(const std::string& name, std::function<void()> set, const std::string& help) {
+    command_line_.custom_flag(name, std::move(set), help);
+  }
+  /// As cli::CommandLine::custom_option.
+  void custom_option(const std::string& name, std::function<void(const std::string&)> parse,
+                     const std::string& default_text, const std::string& help) {
+    command_line_.custom_option(name, std::move(parse), default_text, help);
     value_options_.insert(name);
   }
   /// --name VALUE that may be given several times; every value is appended to *target.

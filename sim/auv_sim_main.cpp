@@ -5,6 +5,7 @@
 #include "common/cli.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
+#include "common/transport_options.hpp"
 #include "sim/open_loop.hpp"
 #include "sim/sim_server.hpp"
 
@@ -17,9 +18,10 @@ int main(int argc, char** argv) {
   std::string open_loop_in, open_loop_out;
   bool ideal_thrusters = false;
 
-  cli::CommandLine cmd("auv_sim",
-                       "Simulates K vehicles served over LCM (lockstep for training, real time for "
-                       "demos), or runs thrust commands open loop from a CSV file.");
+  cli::CommandLine cmd(
+      "auv_sim",
+      "Simulates K vehicles served over the transport (lockstep for training, real time for "
+      "demos), or runs thrust commands open loop from a CSV file.");
   cmd.option("vehicle", &vehicle_path, "vehicle file (YAML)");
   cmd.option("vehicles", &server.num_vehicles, "number of vehicles K");
   cmd.option("first-vehicle-id", &server.first_vehicle_id,
@@ -27,12 +29,9 @@ int main(int argc, char** argv) {
   cmd.flag("realtime", &realtime, "step at wall-clock rate with the latest command");
   cmd.option("realtime-factor", &server.realtime_factor, "real-time mode: sim seconds per second");
   cmd.option("heartbeat-period", &server.heartbeat_period_s, "heartbeat period, s");
-  cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL of the system's bus (heartbeat)");
-  std::string lockstep_url;
-  cmd.option("lockstep-lcm-url", &lockstep_url,
-             "a bus of its own for commands and states (default: the system's bus)");
-  cmd.flag("allow-off-host", &transport_config.allow_off_host,
-           "accept an LCM URL whose traffic can leave this host (no authentication!)");
+  transport::add_transport_options(cmd, transport_config);
+  transport::LockstepBusOptions lockstep_bus;
+  transport::add_lockstep_options(cmd, lockstep_bus);
   cmd.option("open-loop", &open_loop_in, "open-loop tool: input CSV t,f1..fN (N)");
   cmd.option("out", &open_loop_out, "open-loop tool: output CSV");
   cmd.flag("ideal-thrusters", &ideal_thrusters, "open-loop tool: no thruster delay, lag or slew");
@@ -61,15 +60,14 @@ int main(int argc, char** argv) {
     server.lockstep = !realtime;
     server.vehicle_file = vehicle_path;
     auto transport = transport::make_transport(transport_config);
+    const auto lockstep_config = transport::lockstep_bus_config(transport_config, lockstep_bus);
     std::unique_ptr<transport::Transport> lockstep;
-    if (!lockstep_url.empty()) {
-      lockstep = transport::make_transport({lockstep_url, transport_config.allow_off_host});
-    }
+    if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
     signals::install_stop_handlers();
     sim::SimServer sim_server(model, lockstep ? *lockstep : *transport, server, transport.get());
     std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " (" << vehicle_path
               << "), " << (realtime ? "real time" : "lockstep") << ", "
-              << (lockstep_url.empty() ? transport_config.lcm_url : lockstep_url) << "\n";
+              << transport::describe(lockstep_config ? *lockstep_config : transport_config) << "\n";
     sim_server.run([] { return signals::stop_requested(); });
     const auto counters = sim_server.counters();
     std::cerr << "auv_sim: stopped after " << counters.steps_total << " steps, "

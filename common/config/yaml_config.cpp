@@ -199,7 +199,7 @@ Section load_file(const std::string& path) {
 namespace auvrl::config {
 
 void finish_run_file(Section& root) {
-  root.ignore({"vehicle", "task", "schedule", "learner", "actor", "run"});
+  root.ignore({"vehicle", "task", "schedule", "learner", "actor", "run", "transport"});
   root.finish();
 }
 

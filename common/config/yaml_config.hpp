@@ -76,6 +76,7 @@ namespace auvrl::config {
 ///   vehicle: path of the vehicle file, relative to the configuration's directory
 ///   task:, schedule:   common/task (every process)
 ///   learner:           auv_learner        actor:   auv_actor        run:   the launcher
+///   transport:         the launcher (passed to every process as flags)
 void finish_run_file(Section& root);
 
 /// A path from a configuration file: absolute as is, else relative to the file's directory.

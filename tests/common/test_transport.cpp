@@ -100,8 +100,9 @@ TEST(Transport, RefusesUrlsThatLeaveTheHost) {
   EXPECT_THROW(check_url_is_host_only("tcpq://10.0.0.2:7700", false), transport::TransportError);
   EXPECT_THROW(check_url_is_host_only("bogus://x", false), transport::TransportError);
   EXPECT_NO_THROW(check_url_is_host_only("udpm://239.255.76.67:7667?ttl=1", true));
-  EXPECT_THROW(transport::make_transport({"udpm://239.255.76.67:7667?ttl=1", false}),
-               transport::TransportError);
+  transport::TransportConfig off_host;
+  off_host.lcm_url = "udpm://239.255.76.67:7667?ttl=1";
+  EXPECT_THROW(transport::make_transport(off_host), transport::TransportError);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <fstream>
 #include <thread>
@@ -67,7 +68,16 @@ TEST(DdsTransport, ClassesOfARegex) {
             (V{ChannelClass::kLockstep, ChannelClass::kOther}));
   // An optional character shortens the literal prefix; an alternation gives everything.
   EXPECT_EQ(classes_possibly_matching("POLICY_WEIGHTS?").size(), 1u);
-  EXPECT_EQ(classes_possibly_matching("EXPERIENCE|LEARNER_STATS").size(), 4u);
+  EXPECT_EQ(classes_possibly_matching("EXPERIENCE|LEARNER_STATS"),
+            (V{ChannelClass::kQueue, ChannelClass::kOther}));
+  EXPECT_EQ(classes_possibly_matching("(POLICY_WEIGHTS|SIM_HEARTBEAT)"),
+            (V{ChannelClass::kState, ChannelClass::kOther}));
+  EXPECT_EQ(classes_possibly_matching("(EPISODE)|(SIM_STATE_[0-9]+)"),
+            (V{ChannelClass::kQueue, ChannelClass::kLockstep}));
+  EXPECT_EQ(classes_possibly_matching("EPISODE|[|]"),
+            (V{ChannelClass::kState, ChannelClass::kQueue, ChannelClass::kLockstep,
+               ChannelClass::kOther}));
+  EXPECT_EQ(classes_possibly_matching("SIM_(CMD|STATE)_1").size(), 4u) << "nested: everything";
   EXPECT_EQ(channels::channel_class(channels::kPolicySummary), ChannelClass::kState);
   EXPECT_EQ(channels::channel_class(channels::kWeightsRequest), ChannelClass::kQueue);
   EXPECT_EQ(channels::channel_class(channels::sim_fault(12)), ChannelClass::kLockstep);
@@ -310,6 +320,37 @@ TEST(DdsTransportProcesses, LateJoiningProcessGetsTheNewestWeightsWithoutAsking)
   EXPECT_EQ(status, 0) << log;
   EXPECT_NE(log.find("count=1 size=512000 version=100"), std::string::npos) << log;
   std::cout << "late joiner: " << log;
+}
+
+TEST(DdsTransportProcesses, WeightsDoNotWaitForAKilledReader) {
+  // Keep-last state: a reader that died without a word (its lease has not yet expired) must
+  // not hold the learner's broadcasts up.
+  const std::string dir = test_support::make_temp_dir("auvrl_dds_killed_");
+  auto t = transport::make_transport(dds_config());
+  int pongs = 0;
+  t->subscribe("PONG", [&](const RawMessage&) { ++pongs; });
+  test_support::ChildProcess peer(
+      {test_support::bin_path("dds_peer"), "echo", channels::kPolicyWeights, "PONG"},
+      dir + "/peer.log");
+  const auto weights = message(1, 500 * 1024);
+  ASSERT_TRUE(handle_until(
+      *t,
+      [&] {
+        t->publish(channels::kPolicyWeights, weights.data(), weights.size());
+        return pongs > 0;
+      },
+      std::chrono::seconds(10)))
+      << peer.log();
+  peer.signal(SIGKILL);
+  double slowest_ms = 0;
+  for (int i = 0; i < 40; ++i) {
+    const auto start = Clock::now();
+    t->publish(channels::kPolicyWeights, weights.data(), weights.size());
+    slowest_ms = std::max(slowest_ms,
+                          std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+    t->handle(25);
+  }
+  EXPECT_LT(slowest_ms, 50.0);
 }
 
 }  // namespace
