@@ -20,14 +20,13 @@ class ActorNode::ExploringController final : public Controller {
   void act(const task::Observation& obs, const Eigen::Vector3d& goal,
            const task::StateVector& state, task::ActionVector& action) override {
     node_.refresh_policy();
-    if (policy_) {
-      policy_->act(obs, goal, state, action);
+    if (PolicyController* policy = node_.policy_.policy()) {
+      policy->act(obs, goal, state, action);
     } else {
       action.setZero(node_.config_.task.num_thrusters);
     }
   }
   std::string name() const override { return "actor"; }
-  std::unique_ptr<PolicyController> policy_;
 
  private:
   ActorNode& node_;
@@ -45,7 +44,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
              config_.seed * 0x9E3779B97F4A7C15ull + 1),
       goal_rng_(config_.seed),
-      beta_m_(config_.initial_beta_m) {
+      policy_(config_.task.state_dim(), config_.task.num_thrusters, config_.initial_beta_m) {
   config_.task.validate();
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
 }
@@ -56,37 +55,31 @@ void ActorNode::refresh_policy() {
   // Weights supersede each other: drain what is pending, keep only the newest.
   transport_.drain();
   if (auto msg = weights_.take()) {
-    last_weights_ = Clock::now();
-    training_done_ = msg->training_done;
-    learner_backlog_ = msg->updates_owed;
-    if (msg->version != policy_version_ || !controller_->policy_) {
-      try {
-        nn::Mlp network = nn::network_from_bytes(
-            reinterpret_cast<const std::uint8_t*>(msg->network.data()), msg->network.size(), 1);
-        auto policy = std::make_unique<PolicyController>(
-            std::move(network), config_.task.state_dim(), config_.task.num_thrusters);
-        controller_->policy_ = std::move(policy);
-        policy_version_ = msg->version;
-        beta_m_ = msg->beta_m;
+    std::string error;
+    switch (policy_.apply(*msg, error)) {
+      case WeightsOutcome::kApplied:
+        last_weights_ = Clock::now();
         ++counters_.weights_applied;
-      } catch (const std::exception& e) {
+        break;
+      case WeightsOutcome::kRefreshed:
+        last_weights_ = Clock::now();
+        break;
+      case WeightsOutcome::kRejected:
         ++counters_.weights_rejected;
         log_ << "auv_actor " << config_.actor_id << ": weights version " << msg->version
-             << " rejected: " << e.what() << "\n";
-      }
-    } else {
-      beta_m_ = msg->beta_m;
+             << " rejected: " << error << "\n";
+        break;
     }
   }
   const auto now = Clock::now();
   const double silence = std::chrono::duration<double>(now - last_weights_).count();
   const double since_request = std::chrono::duration<double>(now - last_request_).count();
-  const bool want = !controller_->policy_ || silence > config_.weights_silence_s;
+  const bool want = policy_.policy() == nullptr || silence > config_.weights_silence_s;
   if (want && since_request >= config_.weights_request_period_s) {
     auvrl_lcm::weights_request_t req{};
     req.utime = transport::now_utime();
     req.actor_id = config_.actor_id;
-    req.have_version = policy_version_;
+    req.have_version = policy_.version();
     transport::publish(transport_, channels::kWeightsRequest, req);
     last_request_ = now;
     ++counters_.weights_requests;
@@ -97,7 +90,7 @@ void ActorNode::wait_for_learner() {
   if (config_.max_learner_backlog <= 0) return;
   const auto start = Clock::now();
   refresh_policy();
-  while (learner_backlog_ > config_.max_learner_backlog && !training_done_) {
+  while (policy_.learner_backlog() > config_.max_learner_backlog && !policy_.training_done()) {
     // The learner broadcasts its weights (and backlog) as it works the backlog off; one
     // that went silent does not hold the actor up for longer than max_wait_s.
     if (std::chrono::duration<double>(Clock::now() - last_weights_).count() > config_.max_wait_s) {
@@ -115,7 +108,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   ++episode_id_;
   EpisodeOptions options;
   options.goal_ned_m = task::sample_goal(config_.task, goal_rng_);
-  options.beta_m = beta_m_;
+  options.beta_m = policy_.beta_m();
   options.start.position_ned_m = config_.task.start_position_ned_m;
   options.start.euler_rpy_rad = {0.0, 0.0, config_.task.start_yaw_rad};
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
@@ -152,7 +145,7 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
     msg.utime = transport::now_utime();
     msg.actor_id = config_.actor_id;
     msg.batch_seq = ++batch_seq_;
-    msg.policy_version = std::max<std::int64_t>(policy_version_, 0);
+    msg.policy_version = std::max<std::int64_t>(policy_.version(), 0);
     msg.state_dim = state_dim;
     msg.action_dim = action_dim;
     msg.num_transitions = static_cast<std::int32_t>(end - begin);
@@ -181,13 +174,13 @@ void ActorNode::send_report(const EpisodeSummary& summary, const Eigen::Vector3d
   report.utime = transport::now_utime();
   report.actor_id = config_.actor_id;
   report.episode_id = episode_id_;
-  report.policy_version = std::max<std::int64_t>(policy_version_, 0);
+  report.policy_version = std::max<std::int64_t>(policy_.version(), 0);
   report.episode_return = summary.episode_return;
   report.length_steps = summary.length_steps;
   report.success = summary.success;
   report.final_distance_m = summary.final_distance_m;
   report.min_distance_m = summary.min_distance_m;
-  report.beta_m = beta_m_;
+  report.beta_m = policy_.beta_m();
   for (int i = 0; i < 3; ++i) report.goal_ned_m[i] = goal[i];
   report.thrust_energy = summary.thrust_energy;
   report.end_reason = static_cast<std::int8_t>(summary.end_reason);

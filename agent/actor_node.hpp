@@ -12,6 +12,7 @@
 
 #include "agent/controller.hpp"
 #include "agent/episode.hpp"
+#include "agent/policy_receiver.hpp"
 #include "agent/vehicle_link.hpp"
 #include "common/sim_client.hpp"
 #include "common/task/task.hpp"
@@ -67,9 +68,9 @@ class ActorNode {
   EpisodeSummary run_one_episode();
 
   /// The learner said training is over.
-  bool training_done() const { return training_done_; }
-  std::int64_t policy_version() const { return policy_version_; }
-  double beta_m() const { return beta_m_; }
+  bool training_done() const { return policy_.training_done(); }
+  std::int64_t policy_version() const { return policy_.version(); }
+  double beta_m() const { return policy_.beta_m(); }
   const ActorCounters& counters() const { return counters_; }
 
  private:
@@ -92,10 +93,8 @@ class ActorNode {
   /// Waits (flow control) while the learner's backlog is above the configured limit.
   void wait_for_learner();
 
-  std::int64_t policy_version_ = -1;  ///< -1: no policy yet (noise alone)
-  double learner_backlog_ = 0.0;      ///< from the newest weights message
-  double beta_m_;
-  bool training_done_ = false;
+  /// The policy, its version (-1: none yet, noise alone), beta and the learner's backlog.
+  PolicyReceiver policy_;
   std::int64_t batch_seq_ = 0;
   std::int64_t episode_id_ = 0;
   std::chrono::steady_clock::time_point last_weights_;

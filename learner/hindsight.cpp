@@ -1,5 +1,6 @@
 #include "learner/hindsight.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -18,7 +19,9 @@ void HindsightRelabeler::on_add(const ReplayBuffer& replay, std::size_t slot, bo
   if (overwrote) episodes_.erase(overwritten_episode);
   std::vector<std::int64_t>& slots = episodes_[replay.episode_id(slot)];
   const std::size_t step = replay.step_index(slot);
-  if (step >= 100000) return;  // implausible: leave it out of relabelling
+  // Beyond the task's episode length: not from an actor of this task (a hostile or corrupt
+  // step index would otherwise size this episode's index, 8 bytes per claimed step).
+  if (step >= static_cast<std::size_t>(std::max(task_.max_steps, 1))) return;
   if (slots.size() <= step) slots.resize(step + 1, -1);
   slots[step] = static_cast<std::int64_t>(slot);
 }

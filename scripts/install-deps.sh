@@ -7,8 +7,8 @@ packages=(
   build-essential cmake pkg-config
   # libraries
   libeigen3-dev libyaml-cpp-dev liblcm-dev libglib2.0-dev cyclonedds-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; the fuzz build (clang, libFuzzer)
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # LCM tools, Java bindings for lcm-spy, DDS tools
   liblcm-bin liblcm-java libjchart2d-java default-jdk-headless cyclonedds-tools
   # network namespaces (unshare, nsenter, ip) and process tools

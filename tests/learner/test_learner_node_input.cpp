@@ -1,0 +1,139 @@
+// auv_learner's handling of hostile messages with a valid LCM encoding, in-process (memq):
+// experience with wrong dimensions, NaN/inf, actions beyond the tanh range, too many or no
+// transitions, unknown actor ids, and episode reports from unknown actors are dropped and
+// counted; nothing of them reaches the replay buffer, the updates or the schedule.
+#include <gtest/gtest.h>
+
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/experience_batch_t.hpp>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "common/channels.hpp"
+#include "learner/learner_node.hpp"
+#include "synthetic_experience.hpp"
+
+namespace {
+
+using namespace auvrl;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+class LearnerNodeInput : public ::testing::Test {
+ protected:
+  LearnerNodeInput() : transport_(transport::make_in_process_transport()) {
+    config_.ddpg.state_dim = config_.task.state_dim();
+    config_.ddpg.action_dim = config_.task.num_thrusters;
+    config_.ddpg.actor_hidden = {8, 8};
+    config_.ddpg.critic_hidden = {8, 8};
+    config_.ddpg.batch_size = 4;
+    config_.ddpg.replay_capacity = 256;
+    config_.her = true;
+    config_.max_actors = 4;
+    config_.max_transitions_per_batch = 50;
+    node_ = std::make_unique<learner::LearnerNode>(config_, *transport_, log_);
+  }
+
+  auvrl_lcm::experience_batch_t batch(int n = 5, int actor = 1) {
+    return test_support::synthetic_experience_batch(actor, ++seq_, n, config_.ddpg.state_dim,
+                                                    config_.ddpg.action_dim);
+  }
+  template <class Msg>
+  void send(const std::string& channel, const Msg& msg) {
+    transport::publish(*transport_, channel, msg);
+    node_->poll(0);
+    transport_->drain();
+  }
+  /// Asserts that nothing was taken in.
+  void expect_untouched() {
+    EXPECT_EQ(node_->replay().size(), 0u);
+    EXPECT_EQ(node_->counters().transitions_received, 0);
+    EXPECT_EQ(node_->updates(), 0);
+  }
+
+  learner::LearnerNodeConfig config_;
+  std::unique_ptr<transport::Transport> transport_;
+  std::ostringstream log_;
+  std::unique_ptr<learner::LearnerNode> node_;
+  std::int64_t seq_ = 0;
+};
+
+TEST_F(LearnerNodeInput, WrongDimensionsAndCountsAreDropped) {
+  const int sd = config_.ddpg.state_dim, ad = config_.ddpg.action_dim;
+  // Consistent arrays, but not the learner's sizes.
+  send(channels::kExperience, test_support::synthetic_experience_batch(1, 1, 5, sd + 1, ad));
+  send(channels::kExperience, test_support::synthetic_experience_batch(1, 2, 5, sd, ad - 1));
+  send(channels::kExperience, test_support::synthetic_experience_batch(1, 3, 5, 0, 0));
+  send(channels::kExperience, batch(0));                                      // no transitions
+  send(channels::kExperience, batch(config_.max_transitions_per_batch + 1));  // too many
+  EXPECT_EQ(node_->counters().dropped_dims, 5);
+  expect_untouched();
+}
+
+TEST_F(LearnerNodeInput, NonFiniteValuesAnywhereAreDropped) {
+  auto b = batch();
+  b.states[1][3] = std::nanf("");
+  send(channels::kExperience, b);
+  b = batch();
+  b.next_states[4][0] = kInf;
+  send(channels::kExperience, b);
+  b = batch();
+  b.rewards[0] = -kInf;
+  send(channels::kExperience, b);
+  b = batch();
+  b.actions[2][5] = std::nanf("");
+  send(channels::kExperience, b);
+  b = batch();
+  b.achieved_position_ned_m[3][2] = kInf;
+  send(channels::kExperience, b);
+  b = batch();
+  b.goal_ned_m[0][1] = std::nanf("");
+  send(channels::kExperience, b);
+  b = batch();
+  b.actions[0][0] = 1.5f;  // beyond tanh: not from a policy
+  send(channels::kExperience, b);
+  EXPECT_EQ(node_->counters().dropped_non_finite, 7);
+  expect_untouched();
+}
+
+TEST_F(LearnerNodeInput, UnknownActorsAreDroppedAndDoNotAdvanceTheSchedule) {
+  send(channels::kExperience, batch(5, -1));
+  send(channels::kExperience, batch(5, config_.max_actors));
+  send(channels::kExperience, batch(5, std::numeric_limits<std::int32_t>::max()));
+  auvrl_lcm::episode_report_t report{};
+  report.actor_id = 99;
+  send(channels::kEpisode, report);
+  report.actor_id = -7;
+  send(channels::kEpisode, report);
+  EXPECT_EQ(node_->counters().dropped_unknown_actor, 5);
+  EXPECT_EQ(node_->episodes(), 0);
+  expect_untouched();
+}
+
+TEST_F(LearnerNodeInput, HostileStepIndicesAndEpisodeIdsAreStoredSafely) {
+  // Values the learner cannot check against anything: extreme but valid numbers must neither
+  // crash the hindsight index nor make it allocate per claimed step.
+  auto b = batch(8);
+  b.step_index = {-1, std::numeric_limits<std::int32_t>::max(), 0, 99999, 5, 5, 3, 700};
+  b.episode_id = {std::numeric_limits<std::int64_t>::min(), -1, 0, 1, 2, 2, 2,
+                  std::numeric_limits<std::int64_t>::max()};
+  send(channels::kExperience, b);
+  EXPECT_EQ(node_->replay().size(), 8u);
+  for (int i = 0; i < 20; ++i) node_->poll(0);  // updates sample and relabel these
+  EXPECT_GT(node_->updates(), 0);
+  transport_->drain();
+}
+
+TEST_F(LearnerNodeInput, UndecodableBytesAreCounted) {
+  const std::uint8_t garbage[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};
+  transport_->publish(channels::kExperience, garbage, sizeof garbage);
+  transport_->publish(channels::kEpisode, garbage, sizeof garbage);
+  transport_->publish(channels::kWeightsRequest, garbage, sizeof garbage);
+  node_->poll(0);
+  EXPECT_EQ(node_->counters().dropped_decode, 3);
+  EXPECT_EQ(node_->counters().weights_requests, 0);
+  expect_untouched();
+}
+
+}  // namespace

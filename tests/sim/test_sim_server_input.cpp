@@ -1,0 +1,173 @@
+// auv_sim's handling of hostile messages with a valid LCM encoding, in-process (memq): wrong
+// thruster counts, NaN and inf, out-of-range values, unknown or mismatched vehicle ids, stale
+// sequence numbers and undecodable bytes are dropped and counted, and never change a vehicle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "common/channels.hpp"
+#include "common/transport.hpp"
+#include "sim/sim_server.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace {
+
+using namespace auvrl;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+class SimServerInput : public ::testing::Test {
+ protected:
+  SimServerInput()
+      : model_(sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml")),
+        transport_(transport::make_in_process_transport()),
+        server_(model_, *transport_, config()) {}
+
+  static sim::SimServerConfig config() {
+    sim::SimServerConfig c;
+    c.num_vehicles = 2;
+    c.heartbeat_period_s = 3600;
+    return c;
+  }
+  static auvrl_lcm::vehicle_reset_t reset(int id, std::int64_t seq = 1) {
+    auvrl_lcm::vehicle_reset_t m{};
+    m.vehicle_id = id;
+    m.seq = seq;
+    m.position_ned_m[2] = 5.0;
+    m.current_gm_time_constant_s = 10.0;
+    return m;
+  }
+  static auvrl_lcm::thruster_cmd_t command(int id, std::int64_t seq, double thrust = 10.0) {
+    auvrl_lcm::thruster_cmd_t m{};
+    m.vehicle_id = id;
+    m.seq = seq;
+    m.num_thrusters = 6;
+    m.thrust_n.assign(6, thrust);
+    return m;
+  }
+  template <class Msg>
+  void send(const std::string& channel, const Msg& msg) {
+    transport::publish(*transport_, channel, msg);
+    server_.poll(0);
+    transport_->drain();
+  }
+  std::int64_t steps(int id) const { return server_.vehicle(id)->step_count; }
+
+  sim::VehicleModel model_;
+  std::unique_ptr<transport::Transport> transport_;
+  sim::SimServer server_;
+};
+
+TEST_F(SimServerInput, WrongThrusterCountsAreDroppedAndCounted) {
+  send(channels::sim_reset(0), reset(0));
+  auto cmd = command(0, 2);
+  cmd.num_thrusters = 5;
+  cmd.thrust_n.resize(5);
+  send(channels::sim_command(0), cmd);
+  auvrl_lcm::thruster_fault_t fault{};
+  fault.num_thrusters = 7;
+  fault.thruster_efficiency.assign(7, 0.5);
+  send(channels::sim_fault(0), fault);
+  auto bad_reset = reset(1);
+  bad_reset.num_thrusters = 3;
+  bad_reset.thruster_efficiency.assign(3, 1.0);
+  send(channels::sim_reset(1), bad_reset);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.dropped_thrusters, 3);
+  EXPECT_EQ(c.steps_total, 0);
+  EXPECT_EQ(c.faults_total, 0);
+  EXPECT_EQ(server_.vehicle(1), nullptr) << "a refused reset must not activate the vehicle";
+  EXPECT_DOUBLE_EQ(server_.vehicle(0)->thruster_efficiency.minCoeff(), 1.0);
+}
+
+TEST_F(SimServerInput, NanAndInfAnywhereAreDroppedAndNeverApplied) {
+  send(channels::sim_reset(0), reset(0));
+  const sim::Vector6 eta_before = server_.vehicle(0)->eta;
+  auto cmd = command(0, 2);
+  cmd.thrust_n[3] = std::nan("");
+  send(channels::sim_command(0), cmd);
+  cmd = command(0, 3);
+  cmd.thrust_n[0] = -kInf;
+  send(channels::sim_command(0), cmd);
+  auto r = reset(0, 4);
+  r.position_ned_m[1] = kInf;
+  send(channels::sim_reset(0), r);
+  r = reset(0, 5);
+  r.noise_attitude_rad = std::nan("");
+  send(channels::sim_reset(0), r);
+  auvrl_lcm::thruster_fault_t fault{};
+  fault.num_thrusters = 6;
+  fault.thruster_efficiency = {1, 1, std::nan(""), 1, 1, 1};
+  send(channels::sim_fault(0), fault);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.dropped_non_finite, 5);
+  EXPECT_EQ(c.steps_total, 0);
+  EXPECT_EQ(c.resets_total, 1);
+  EXPECT_EQ(c.faults_total, 0);
+  EXPECT_EQ(steps(0), 0);
+  EXPECT_EQ(server_.vehicle(0)->eta, eta_before);
+  // The vehicle still steps on a good command.
+  send(channels::sim_command(0), command(0, 6));
+  EXPECT_EQ(steps(0), 1);
+}
+
+TEST_F(SimServerInput, OutOfRangeResetAndFaultValuesAreDropped) {
+  send(channels::sim_reset(0), reset(0));
+  auto r = reset(0, 2);
+  r.noise_position_m = -0.1;  // negative standard deviation
+  send(channels::sim_reset(0), r);
+  r = reset(0, 3);
+  r.current_gm_time_constant_s = 0.0;  // a varying current without a time constant
+  r.current_gm_sigma_mps = 0.1;
+  send(channels::sim_reset(0), r);
+  r = reset(0, 4);
+  r.num_thrusters = 6;
+  r.thruster_efficiency = {1, 1, 1, 1, 1, -0.5};
+  send(channels::sim_reset(0), r);
+  auvrl_lcm::thruster_fault_t fault{};
+  fault.num_thrusters = 6;
+  fault.thruster_efficiency = {1, 1, 1, 1e9, 1, 1};
+  send(channels::sim_fault(0), fault);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.dropped_out_of_range, 4);
+  EXPECT_EQ(c.resets_total, 1);
+  EXPECT_EQ(c.faults_total, 0);
+}
+
+TEST_F(SimServerInput, UnknownAndMismatchedVehicleIdsAreDropped) {
+  send(channels::sim_reset(0), reset(0));
+  send(channels::sim_reset(2), reset(2));                 // past the served range
+  send(channels::sim_command(99999), command(99999, 2));  // far out
+  send(channels::sim_command(1), command(0, 2));          // id not matching the channel
+  send("SIM_CMD_99999999999999999999", command(0, 2));    // id that overflows an int
+  auto negative = command(-1, 2);
+  send(channels::sim_command(0), negative);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.dropped_vehicle_id, 5);
+  EXPECT_EQ(c.steps_total, 0);
+  EXPECT_EQ(steps(0), 0);
+}
+
+TEST_F(SimServerInput, StaleUnresetAndUndecodableMessagesAreDropped) {
+  send(channels::sim_command(1), command(1, 2));  // vehicle 1 never reset
+  send(channels::sim_reset(0), reset(0, 10));
+  send(channels::sim_command(0), command(0, 9));  // older than the reset
+  const std::uint8_t garbage[7] = {0xde, 0xad, 0xbe, 0xef, 0, 1, 2};
+  transport_->publish(channels::sim_command(0), garbage, sizeof garbage);
+  server_.poll(0);
+  // A command whose thrust_n claims more elements than the message holds.
+  auto cmd = command(0, 11);
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(cmd.getEncodedSize()));
+  cmd.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  bytes.resize(bytes.size() - 8);
+  transport_->publish(channels::sim_command(0), bytes.data(), bytes.size());
+  server_.poll(0);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.dropped_not_reset, 1);
+  EXPECT_EQ(c.dropped_stale, 1);
+  EXPECT_EQ(c.dropped_decode, 2);
+  EXPECT_EQ(c.steps_total, 0);
+}
+
+}  // namespace
