@@ -122,9 +122,12 @@ TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
     return 0;
   };
   const auto episodes_seen = static_cast<std::int64_t>(episodes[0].size() + episodes[1].size());
-  // The logger's last heartbeat after everything else stopped counts every episode.
-  while (std::chrono::steady_clock::now() < heartbeat_deadline &&
-         written(channels::kEpisode) < episodes_seen) {
+  // A heartbeat after everything else stopped counts everything the monitor saw.
+  const auto logged_all = [&] {
+    return written(channels::kEpisode) >= episodes_seen && written(channels::kExperience) > 0 &&
+           written(channels::kPolicySummary) > 0 && written(channels::kLearnerStats) > 0;
+  };
+  while (std::chrono::steady_clock::now() < heartbeat_deadline && !logged_all()) {
     monitor->handle(100);
   }
   ASSERT_TRUE(logged.has_value()) << logger.log();
