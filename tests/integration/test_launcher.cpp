@@ -1,7 +1,7 @@
 // auvrl train as a real process (inside this test's private network namespace): it supervises
-// (an actor killed with SIGKILL is back within seconds), stops cleanly on Ctrl-C with a
-// checkpoint and the policy written, resumes, and a short run of the fast preset learns: the
-// evaluated policy does far better than an untrained one.
+// (an actor killed with SIGKILL is back within seconds; over LCM and over DDS), stops cleanly on
+// Ctrl-C with a checkpoint and the policy written, resumes, and a short run of the fast preset
+// learns: the evaluated policy does far better than an untrained one.
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -80,12 +80,16 @@ std::string quick_checkpoint_config(const std::string& dir) {
   return path;
 }
 
-TEST(Launcher, RestartsKilledProcessesStopsCleanlyAndResumes) {
+/// The supervision test runs once per transport (lcm, dds): auvrl train --transport NAME.
+class LauncherSupervision : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(LauncherSupervision, RestartsKilledProcessesStopsCleanlyAndResumes) {
   const std::string tmp = test_support::make_temp_dir("auvrl_launcher_");
   const std::string dir = tmp + "/run";
   ChildProcess train(
       {test_support::bin_path("auvrl"), "train", "--config", quick_checkpoint_config(tmp),
-       "--run-dir", dir, "--network", "host", "--actors", "2", "--max-seconds", "60", "--no-eval"},
+       "--run-dir", dir, "--network", "host", "--actors", "2", "--max-seconds", "60", "--no-eval",
+       "--transport", GetParam()},
       dir + ".log");
   const auto learner_log = [&] {
     std::ifstream in(fs::path(dir) / "processes" / "learner.log");
@@ -149,12 +153,19 @@ TEST(Launcher, RestartsKilledProcessesStopsCleanlyAndResumes) {
   };
   const std::size_t resumes_before = count_resumes();
   ChildProcess resumed({test_support::bin_path("auvrl"), "train", "--resume", dir, "--network",
-                        "host", "--max-seconds", "0.001", "--no-eval"},
+                        "host", "--max-seconds", "0.001", "--no-eval", "--transport", GetParam()},
                        dir + "-resume.log");
   ASSERT_GE(resumed.wait_for_exit(std::chrono::seconds(60)), 0) << resumed.log();
   EXPECT_EQ(count_resumes(), resumes_before + 1) << learner_log();
   EXPECT_GT(updates_before, 0);
+  EXPECT_NE(train.log().find(GetParam() == "dds" ? "dds domain 0" : "udpm://"), std::string::npos)
+      << "the run's transport";
 }
+
+INSTANTIATE_TEST_SUITE_P(Transports, LauncherSupervision, ::testing::Values("lcm", "dds"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });
 
 TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
   const std::string dir = test_support::make_temp_dir("auvrl_launcher_learn_") + "/run";
