@@ -47,8 +47,8 @@ struct DdsSettings {
   /// stops the tenth process on a host).
   int max_auto_participant_index = 120;
   /// Lockstep channels (SIM_CMD_/SIM_STATE_/...): reliable (true) or best effort. The sim
-  /// client resends a command whose answer is missing, so best effort would be safe too;
-  /// reliable was as fast on loopback (see README, bench_lockstep --transport dds).
+  /// client resends a command whose answer is missing, so best effort is safe too; the
+  /// README's benchmarks compare the two (bench_lockstep).
   bool lockstep_reliable = true;
 };
 

@@ -50,6 +50,9 @@ std::vector<std::string> transport_arguments(const TransportConfig& config) {
       args.insert(args.end(), {"--dds-config", config.dds.config_path});
     }
   }
+  if (config.kind == TransportKind::kDds && !config.dds.lockstep_reliable) {
+    args.push_back("--dds-lockstep-best-effort");
+  }
   if (config.allow_off_host) args.push_back("--allow-off-host");
   return args;
 }

@@ -69,6 +69,14 @@ void add_transport_options(CommandLineT& cmd, TransportConfig& config,
       },
       "", "a Cyclone XML file replacing the generated configuration (needs --allow-off-host)");
   cmd.custom_flag(
+      "dds-lockstep-best-effort",
+      [&config, record] {
+        config.dds.lockstep_reliable = false;
+        record("dds-lockstep-best-effort", "");
+      },
+      "DDS: lockstep commands and states best effort instead of reliable (every process of "
+      "a lockstep pair must agree)");
+  cmd.custom_flag(
       "allow-off-host",
       [&config, record] {
         config.allow_off_host = true;

@@ -1,7 +1,8 @@
-// Lockstep control steps per second over LCM: auv_sim as a real process, one client, then two
-// client processes at once, each driving its own vehicle; first with the processes placed by
-// the scheduler, then with all of them pinned to one CPU. Prints one line per client:
-//   lockstep placement=any clients=1 client=0 steps=N steps_per_s=X p50_us=.. p99_us=..
+// Lockstep control steps per second over each transport (LCM, DDS reliable, DDS best effort;
+// --transport picks one): auv_sim as a real process, one client, then two client processes at
+// once, each driving its own vehicle; first with the processes placed by the scheduler, then
+// with all of them pinned to one CPU. Prints one line per client:
+//   lockstep transport=lcm placement=any clients=1 client=0 steps=N steps_per_s=X p50_us=..
 // Pinning matters on virtual machines: a wake-up on another CPU costs an inter-processor
 // interrupt, and a lockstep round trip is four wake-ups (LCM hands every datagram from its
 // receive thread to the handling thread).
@@ -19,6 +20,7 @@
 #include "child_process.hpp"
 #include "common/cli.hpp"
 #include "common/sim_client.hpp"
+#include "common/transport_options.hpp"
 
 namespace {
 
@@ -32,8 +34,14 @@ struct ClientResult {
   int failures = 0;
 };
 
-ClientResult run_client(int vehicle_id, int steps) {
-  auto transport = transport::make_transport({});
+/// A transport to measure: its name in the output and its configuration.
+struct Variant {
+  std::string name;
+  transport::TransportConfig config;
+};
+
+ClientResult run_client(const transport::TransportConfig& config, int vehicle_id, int steps) {
+  auto transport = transport::make_transport(config);
   SimClient client(*transport, vehicle_id);
   auvrl_lcm::vehicle_reset_t reset{};
   reset.position_ned_m[2] = 5.0;
@@ -63,11 +71,13 @@ ClientResult run_client(int vehicle_id, int steps) {
   return result;
 }
 
-void print(const char* placement, int clients, int index, int steps, const ClientResult& r) {
+void print(const std::string& variant, const char* placement, int clients, int index, int steps,
+           const ClientResult& r) {
   std::printf(
-      "lockstep placement=%s clients=%d client=%d steps=%d steps_per_s=%.0f p50_us=%.1f "
-      "p99_us=%.1f failures=%d\n",
-      placement, clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us, r.failures);
+      "lockstep transport=%s placement=%s clients=%d client=%d steps=%d steps_per_s=%.0f "
+      "p50_us=%.1f p99_us=%.1f failures=%d\n",
+      variant.c_str(), placement, clients, index, steps, r.steps_per_s, r.p50_us, r.p99_us,
+      r.failures);
   std::fflush(stdout);
 }
 
@@ -76,14 +86,31 @@ void print(const char* placement, int clients, int index, int steps, const Clien
 int main(int argc, char** argv) {
   int steps = 20000;
   std::string vehicle = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
-  cli::CommandLine cmd("bench_lockstep", "Lockstep steps/s over LCM with one and two clients.");
+  std::string which = "all";
+  cli::CommandLine cmd("bench_lockstep",
+                       "Lockstep steps/s with one and two clients, per transport.");
   cmd.option("steps", &steps, "steps per client");
   cmd.option("vehicle", &vehicle, "vehicle file");
+  cmd.option("transport", &which,
+             "lcm, dds (reliable), dds-best-effort, or all (one after the other, same run)");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
     return 2;
+  }
+  std::vector<Variant> variants;
+  {
+    Variant lcm{"lcm", {}}, dds{"dds", {}}, best_effort{"dds-best-effort", {}};
+    dds.config.kind = best_effort.config.kind = transport::TransportKind::kDds;
+    best_effort.config.dds.lockstep_reliable = false;
+    for (const Variant& v : {lcm, dds, best_effort}) {
+      if (which == "all" || which == v.name) variants.push_back(v);
+    }
+    if (variants.empty()) {
+      std::cerr << "bench_lockstep: --transport: expected lcm, dds, dds-best-effort or all\n";
+      return 2;
+    }
   }
   cpu_set_t all;
   sched_getaffinity(0, sizeof all, &all);
@@ -94,21 +121,25 @@ int main(int argc, char** argv) {
       CPU_SET(0, &one);
       sched_setaffinity(0, sizeof one, &one);  // inherited by auv_sim and the clients
     }
-    test_support::ChildProcess sim(
-        {test_support::bin_path("auv_sim"), "--vehicle", vehicle, "--vehicles", "2"});
-    print(placement, 1, 0, steps, run_client(0, steps));
+    for (const Variant& v : variants) {
+      std::vector<std::string> sim_argv = {test_support::bin_path("auv_sim"), "--vehicle", vehicle,
+                                           "--vehicles", "2"};
+      for (const std::string& a : transport::transport_arguments(v.config)) sim_argv.push_back(a);
+      test_support::ChildProcess sim(sim_argv);
+      print(v.name, placement, 1, 0, steps, run_client(v.config, 0, steps));
 
-    // Two client processes at once, each on its own vehicle; each prints its own line.
-    std::vector<pid_t> children;
-    for (int id = 0; id < 2; ++id) {
-      const pid_t pid = fork();
-      if (pid == 0) {
-        print(placement, 2, id, steps, run_client(id, steps));
-        _exit(0);
+      // Two client processes at once, each on its own vehicle; each prints its own line.
+      std::vector<pid_t> children;
+      for (int id = 0; id < 2; ++id) {
+        const pid_t pid = fork();
+        if (pid == 0) {
+          print(v.name, placement, 2, id, steps, run_client(v.config, id, steps));
+          _exit(0);
+        }
+        children.push_back(pid);
       }
-      children.push_back(pid);
+      for (pid_t pid : children) waitpid(pid, nullptr, 0);
     }
-    for (pid_t pid : children) waitpid(pid, nullptr, 0);
   }
   sched_setaffinity(0, sizeof all, &all);
   return 0;

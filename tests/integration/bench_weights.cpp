@@ -1,7 +1,12 @@
 // Weights delivery: auv_learner (real process, default broadcast setting: after every update,
 // at most every 50 ms) trains on synthetic experience while 4 subscriber processes count the
-// policy_weights_t they receive and their latency. Prints, per actor size:
-//   weights hidden=64-64 bytes=B published=N subscriber=k received=M delivery=M/N p50_ms p99_ms
+// policy_weights_t they receive and their latency; over LCM and over DDS in the same run
+// (--transport picks one). Prints, per transport and actor size:
+//   weights transport=lcm hidden=64-64 bytes=B published=N subscriber=k received=M delivery=M/N
+//     p50_ms p99_ms
+// Then the late joiner: once the learner has published (at least 100 versions) and gone quiet
+// (no experience, so no broadcast), a new subscriber process that sends no request:
+//   late_joiner transport=dds versions_published=N first_ms=X version=V newest=W count=C
 // Run inside a private network namespace: scripts/netns.sh build/bin/bench_weights
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,6 +14,7 @@
 #include <algorithm>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/policy_summary_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
 #include <chrono>
 #include <cstdio>
@@ -21,6 +27,7 @@
 #include "common/channels.hpp"
 #include "common/cli.hpp"
 #include "common/transport.hpp"
+#include "common/transport_options.hpp"
 #include "synthetic_experience.hpp"
 
 namespace {
@@ -31,8 +38,9 @@ constexpr int kStateDim = 23;
 constexpr int kActionDim = 6;
 
 /// A subscriber process: counts weights messages until told to stop (by a file appearing).
-void subscriber(const std::string& result_path, const std::string& stop_path) {
-  auto transport = transport::make_transport({});
+void subscriber(const transport::TransportConfig& config, const std::string& result_path,
+                const std::string& stop_path) {
+  auto transport = transport::make_transport(config);
   std::vector<double> latency_ms;
   std::int64_t bytes = 0;
   transport::subscribe<auvrl_lcm::policy_weights_t>(
@@ -52,14 +60,36 @@ void subscriber(const std::string& result_path, const std::string& stop_path) {
   out << latency_ms.size() << " " << bytes << " " << pct(0.5) << " " << pct(0.99) << "\n";
 }
 
-void run_case(const std::string& hidden, double seconds, int subscribers) {
+/// The late joiner: a process that subscribes (and asks nothing) and writes when the first
+/// weights arrived after it subscribed, their version and how many came in timeout_ms.
+void late_joiner(const transport::TransportConfig& config, const std::string& result_path,
+                 int timeout_ms) {
+  const auto start = Clock::now();
+  auto transport = transport::make_transport(config);
+  double first_ms = -1;
+  std::int64_t version = -1, count = 0;
+  transport::subscribe<auvrl_lcm::policy_weights_t>(
+      *transport, channels::kPolicyWeights,
+      [&](const std::string&, const auvrl_lcm::policy_weights_t& w) {
+        if (count++ == 0) {
+          first_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+          version = w.version;
+        }
+      });
+  const auto end = start + std::chrono::milliseconds(timeout_ms);
+  while (Clock::now() < end) transport->handle(5);
+  std::ofstream(result_path) << first_ms << " " << version << " " << count << "\n";
+}
+
+void run_case(const std::string& name, const transport::TransportConfig& config,
+              const std::string& hidden, double seconds, int subscribers) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
   const std::string stop_path = dir + "/stop";
   std::vector<pid_t> children;
   for (int k = 0; k < subscribers; ++k) {
     const pid_t pid = fork();
     if (pid == 0) {
-      subscriber(dir + "/sub" + std::to_string(k), stop_path);
+      subscriber(config, dir + "/sub" + std::to_string(k), stop_path);
       _exit(0);
     }
     children.push_back(pid);
@@ -69,13 +99,27 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
-  test_support::ChildProcess learner(
-      {test_support::bin_path("auv_learner"), "--state-dim", std::to_string(kStateDim),
-       "--action-dim", std::to_string(kActionDim), "--hidden", hidden, "--batch", "64", "--replay",
-       "100000"},
-      dir + "/learner.log");
-  auto transport = transport::make_transport({});
+  std::vector<std::string> learner_argv = {test_support::bin_path("auv_learner"),
+                                           "--state-dim",
+                                           std::to_string(kStateDim),
+                                           "--action-dim",
+                                           std::to_string(kActionDim),
+                                           "--hidden",
+                                           hidden,
+                                           "--batch",
+                                           "64",
+                                           "--replay",
+                                           "100000"};
+  for (const std::string& a : transport::transport_arguments(config)) learner_argv.push_back(a);
+  test_support::ChildProcess learner(learner_argv, dir + "/learner.log");
+  auto transport = transport::make_transport(config);
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
+  std::int64_t newest_version = -1;
+  transport::subscribe<auvrl_lcm::policy_summary_t>(
+      *transport, channels::kPolicySummary,
+      [&](const std::string&, const auvrl_lcm::policy_summary_t& s) {
+        newest_version = std::max(newest_version, s.version);
+      });
   std::int64_t seq = 0;
   // Experience at 2,000 transitions/s, in batches of 20 (an actor's rate on this machine).
   const auto end = Clock::now() + std::chrono::duration<double>(seconds);
@@ -88,6 +132,35 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
     std::this_thread::sleep_until(next);
     transport->drain();
   }
+  // The late joiner: with the learner quiet (no experience, no broadcast), a new subscriber.
+  auto quiet_since = Clock::now();
+  std::int64_t seen = newest_version;
+  while (Clock::now() - quiet_since < std::chrono::milliseconds(1000)) {
+    transport->handle(20);
+    if (newest_version != seen) {
+      seen = newest_version;
+      quiet_since = Clock::now();
+    }
+  }
+  std::int64_t published_before = -1;
+  if (auto s = stats.take()) published_before = s->weights_published;
+  const std::string late_path = dir + "/late";
+  // A fresh process (exec, not fork: this one's transport has threads).
+  test_support::ChildProcess late(
+      {"/proc/self/exe", "--late-joiner", late_path, "--transport", name}, dir + "/late.log");
+  while (late.running()) transport->handle(10);
+  {
+    std::ifstream in(late_path);
+    double first_ms = -1;
+    long long version = -1, count = 0;
+    in >> first_ms >> version >> count;
+    std::printf(
+        "late_joiner transport=%s hidden=%s versions_published=%lld first_ms=%.2f version=%lld "
+        "newest=%lld count=%lld\n",
+        name.c_str(), hidden.c_str(), static_cast<long long>(published_before), first_ms, version,
+        static_cast<long long>(newest_version), count);
+  }
+
   // Stop the learner first so no weights are in flight, then read its final figures.
   learner.terminate();
   std::optional<auvrl_lcm::learner_stats_t> last;
@@ -105,9 +178,9 @@ void run_case(const std::string& hidden, double seconds, int subscribers) {
     double p50 = 0, p99 = 0;
     in >> received >> bytes >> p50 >> p99;
     std::printf(
-        "weights hidden=%s bytes=%ld published=%lld subscriber=%d received=%ld "
+        "weights transport=%s hidden=%s bytes=%ld published=%lld subscriber=%d received=%ld "
         "delivery=%.4f p50_ms=%.2f p99_ms=%.2f updates=%lld\n",
-        hidden.c_str(), bytes, static_cast<long long>(published), k, received,
+        name.c_str(), hidden.c_str(), bytes, static_cast<long long>(published), k, received,
         published > 0 ? static_cast<double>(received) / static_cast<double>(published) : 0.0, p50,
         p99, static_cast<long long>(last ? last->updates : -1));
   }
@@ -124,16 +197,36 @@ int main(int argc, char** argv) {
   cmd.option("seconds", &seconds, "training time per case");
   cmd.option("subscribers", &subscribers, "subscriber processes");
   cmd.option("hidden", &hidden_list, "comma-separated actor sizes");
+  std::string which = "both";
+  cmd.option("transport", &which, "lcm, dds or both (one after the other, same run)");
+  std::string late_joiner_path;
+  cmd.option("late-joiner", &late_joiner_path,
+             "(internal) be the late joiner over --transport, write the result here");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
     return 2;
   }
+  if (which != "lcm" && which != "dds" && which != "both") {
+    std::cerr << "bench_weights: --transport: expected lcm, dds or both\n";
+    return 2;
+  }
+  if (!late_joiner_path.empty()) {
+    transport::TransportConfig config;
+    config.kind = transport::parse_transport_kind(which);
+    late_joiner(config, late_joiner_path, 1000);
+    return 0;
+  }
   std::size_t start = 0;
   while (start <= hidden_list.size()) {
     const auto comma = std::min(hidden_list.find(',', start), hidden_list.size());
-    run_case(hidden_list.substr(start, comma - start), seconds, subscribers);
+    for (const std::string name : {"lcm", "dds"}) {
+      if (which != "both" && which != name) continue;
+      transport::TransportConfig config;
+      config.kind = transport::parse_transport_kind(name);
+      run_case(name, config, hidden_list.substr(start, comma - start), seconds, subscribers);
+    }
     start = comma + 1;
   }
   return 0;
