@@ -100,14 +100,19 @@ inline transport::Transport& in_process_transport() {
 
 /// A scratch directory of this process (in /dev/shm when there is one), removed at exit.
 inline const std::string& scratch_dir() {
-  static const std::string dir = [] {
+  // Never destroyed: the exit handler that removes the directory runs after static destructors.
+  static const std::string* dir = [] {
     const std::string base = std::filesystem::exists("/dev/shm") ? "/dev/shm" : "/tmp";
     std::string templ = base + "/auvrl-fuzz-XXXXXX";
     if (mkdtemp(templ.data()) == nullptr) std::abort();
-    std::atexit([] { std::filesystem::remove_all(scratch_dir()); });
-    return templ;
+    auto* kept = new std::string(templ);
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(scratch_dir(), ec);
+    });
+    return kept;
   }();
-  return dir;
+  return *dir;
 }
 
 /// Writes data to path (replacing it); aborts if it cannot.

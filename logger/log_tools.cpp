@@ -213,7 +213,10 @@ bool numeric(const std::string& text, double& value) {
 
 bool matches(const std::vector<FieldValue>& fields,
              const std::vector<std::pair<std::string, std::string>>& where) {
-  for (const auto& [name, wanted] : where) {
+  for (const auto& condition : where) {
+    // Not a structured binding: clang 14 (the fuzz build) cannot capture one in a lambda.
+    const std::string& name = condition.first;
+    const std::string& wanted = condition.second;
     const auto it = std::find_if(fields.begin(), fields.end(),
                                  [&](const FieldValue& f) { return f.name == name; });
     if (it == fields.end()) return false;

@@ -28,7 +28,7 @@ while read -r name max_len dict; do
     # libFuzzer's closing figures: executions, rate, corpus.
     grep -E '^(stat::number_of_executed_units|stat::average_exec_per_sec|stat::peak_rss_mb)' "$log" |
       tr '\n' ' '
-    grep -E '^#[0-9]+ +DONE' "$log" | tail -1 || true
+    echo
   else
     echo "fuzz: $name FAILED (log: $log)" >&2
     grep -E 'ERROR|SUMMARY|Test unit written|runtime error' "$log" | head -20 >&2 || true
