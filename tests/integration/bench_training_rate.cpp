@@ -2,8 +2,9 @@
 // their simulators), measured from auv_sim's heartbeats over a window after a warm-up, in two
 // placements: "shared" (one auv_sim for all, everything on one bus, nothing pinned) and
 // "pinned" (what auvrl train does: one auv_sim per actor pinned to the actor's CPU, a private
-// lockstep bus per pair). The learner updates at the given ratio, without flow control.
-// Prints: training placement=P actors=N seconds=S env_steps_per_s=X updates_per_s=Y
+// lockstep bus per pair: an LCM port, or a DDS domain, of its own). The learner updates at the
+// given ratio, without flow control. Over LCM and over DDS in the same run (--transport).
+// Prints: training transport=T placement=P actors=N seconds=S env_steps_per_s=X updates_per_s=Y
 // Run inside a private network namespace: scripts/netns.sh build/bin/bench_training_rate
 #include <unistd.h>
 
@@ -18,23 +19,30 @@
 #include "common/channels.hpp"
 #include "common/cli.hpp"
 #include "common/transport.hpp"
+#include "common/transport_options.hpp"
 
 namespace {
 
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
 
-void run_case(int actors, double seconds, const std::string& learner_ratio, bool pinned) {
+void run_case(const transport::TransportConfig& config, int actors, double seconds,
+              const std::string& learner_ratio, bool pinned) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
-  auto monitor = transport::make_transport({});
+  auto monitor = transport::make_transport(config);
+  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  const bool dds = config.kind == transport::TransportKind::kDds;
   std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *monitor, channels::kSimHeartbeat,
       [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) { heartbeats[h.pid] = h; });
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*monitor, channels::kLearnerStats);
   std::vector<std::unique_ptr<test_support::ChildProcess>> procs;
-  const auto url = [](int i) {
-    return "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576";
+  // The private lockstep bus of pair i (as auvrl train makes it).
+  const auto bus = [&](int i) -> std::vector<std::string> {
+    if (dds) return {"--lockstep-dds-domain", std::to_string(config.dds.domain_id + 1 + i)};
+    return {"--lockstep-lcm-url",
+            "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576"};
   };
   const int cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   for (int i = 0; i < (pinned ? actors : 1); ++i) {
@@ -42,19 +50,33 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
                                      "0.25"};
     if (pinned) {
       argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(i % cpus)});
-      argv.insert(argv.end(),
-                  {"--first-vehicle-id", std::to_string(i), "--lockstep-lcm-url", url(i)});
+      argv.insert(argv.end(), {"--first-vehicle-id", std::to_string(i)});
+      const auto b = bus(i);
+      argv.insert(argv.end(), b.begin(), b.end());
     } else {
       argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
     }
+    argv.insert(argv.end(), transport_args.begin(), transport_args.end());
     procs.push_back(std::make_unique<test_support::ChildProcess>(
         argv, dir + "/sim" + std::to_string(i) + ".log"));
   }
-  test_support::ChildProcess learner(
-      {test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden", "64-64", "--batch",
-       "256", "--state-dim", "23", "--updates-per-transition", learner_ratio, "--warmup", "5000",
-       "--replay", "200000"},
-      dir + "/learner.log");
+  std::vector<std::string> learner_argv = {test_support::bin_path("auv_learner"),
+                                           "--algo",
+                                           "td3",
+                                           "--hidden",
+                                           "64-64",
+                                           "--batch",
+                                           "256",
+                                           "--state-dim",
+                                           "23",
+                                           "--updates-per-transition",
+                                           learner_ratio,
+                                           "--warmup",
+                                           "5000",
+                                           "--replay",
+                                           "200000"};
+  learner_argv.insert(learner_argv.end(), transport_args.begin(), transport_args.end());
+  test_support::ChildProcess learner(learner_argv, dir + "/learner.log");
   for (int id = 0; id < actors; ++id) {
     std::vector<std::string> argv = {test_support::bin_path("auv_actor"),
                                      "--actor-id",
@@ -68,9 +90,11 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
                                      "--layout",
                                      "extended"};
     if (pinned) {
-      argv.insert(argv.end(),
-                  {"--pin-cpu", std::to_string(id % cpus), "--lockstep-lcm-url", url(id)});
+      argv.insert(argv.end(), {"--pin-cpu", std::to_string(id % cpus)});
+      const auto b = bus(id);
+      argv.insert(argv.end(), b.begin(), b.end());
     }
+    argv.insert(argv.end(), transport_args.begin(), transport_args.end());
     procs.push_back(std::make_unique<test_support::ChildProcess>(
         argv, dir + "/actor" + std::to_string(id) + ".log"));
   }
@@ -96,9 +120,10 @@ void run_case(int actors, double seconds, const std::string& learner_ratio, bool
           ? static_cast<double>(last_stats->updates - first_stats->updates) / dt
           : 0.0;
   std::printf(
-      "training placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
+      "training transport=%s placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
       "updates_per_s=%.0f updates_per_transition=%s\n",
-      pinned ? "pinned" : "shared", actors, dt, steps_per_s, updates_per_s, learner_ratio.c_str());
+      transport::to_string(config.kind).c_str(), pinned ? "pinned" : "shared", actors, dt,
+      steps_per_s, updates_per_s, learner_ratio.c_str());
   std::fflush(stdout);
 }
 
@@ -111,15 +136,26 @@ int main(int argc, char** argv) {
                        "Environment steps/s with 1 and 2 actors (one sim, one learner).");
   cmd.option("seconds", &seconds, "measuring window per case");
   cmd.option("updates-per-transition", &ratio, "the learner's update ratio");
+  std::string which = "both";
+  cmd.option("transport", &which, "lcm, dds or both (one after the other, same run)");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
     return 2;
   }
+  if (which != "lcm" && which != "dds" && which != "both") {
+    std::cerr << "bench_training_rate: --transport: expected lcm, dds or both\n";
+    return 2;
+  }
   for (bool pinned : {false, true}) {
-    run_case(1, seconds, ratio, pinned);
-    run_case(2, seconds, ratio, pinned);
+    for (const std::string name : {"lcm", "dds"}) {
+      if (which != "both" && which != name) continue;
+      transport::TransportConfig config;
+      config.kind = transport::parse_transport_kind(name);
+      run_case(config, 1, seconds, ratio, pinned);
+      run_case(config, 2, seconds, ratio, pinned);
+    }
   }
   return 0;
 }
