@@ -95,13 +95,17 @@ class Transport {
   /// Calls handler for each message on channels matching channel_regex (a full-match POSIX
   /// regex, as LCM uses). queue_capacity bounds messages held between handle() calls; when
   /// full, LCM keeps the oldest and drops new ones, so consumers of self-superseding state
-  /// must drain often (see Latest).
+  /// must drain often (see Latest). Over DDS the channel's class decides (common/channels.hpp):
+  /// state keeps only the newest per channel, queue channels make the writer wait, the others
+  /// keep the newest queue_capacity per channel.
   virtual SubscriptionId subscribe(const std::string& channel_regex, RawHandler handler,
                                    int queue_capacity = 1000) = 0;
   virtual void unsubscribe(SubscriptionId id) = 0;
 
   /// Waits up to timeout_ms for one message and dispatches it. Returns true if one was
-  /// handled, false on timeout; throws TransportError on a transport failure.
+  /// handled, false on timeout; throws TransportError on a transport failure. A signal ends
+  /// LCM's wait early (returning false); DDS waits out the timeout, so keep it short (<= 100 ms)
+  /// where a stop request must be seen promptly.
   virtual bool handle_one(int timeout_ms) = 0;
 
   /// Dispatches everything already pending, without waiting. Returns how many.
