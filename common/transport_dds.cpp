@@ -26,6 +26,9 @@ constexpr int kLockstepWriterDepth = 8;
 constexpr int kOtherWriterDepth = 16;
 /// A state-class or other publish that cannot go out within this long fails.
 constexpr std::chrono::milliseconds kDefaultMaxBlocking{1000};
+/// How long closing a transport waits, at most, for readers to acknowledge its queue and state
+/// messages.
+constexpr std::chrono::milliseconds kAckWaitOnClose{3000};
 
 std::string dds_error(dds_return_t rc) { return dds_strretcode(rc); }
 
@@ -175,6 +178,16 @@ class DdsTransport final : public Transport {
   }
 
   ~DdsTransport() override {
+    // A writer's history dies with it: messages that a reader has not acknowledged yet (still
+    // being repaired on a lossy link) would be lost: experience and episode reports, and the
+    // newest weights. Give them a bounded time to arrive (a dead reader that is still matched
+    // holds this up at most that long).
+    const dds_time_t deadline = dds_time() + to_dds(kAckWaitOnClose);
+    for (ChannelClass c : {ChannelClass::kQueue, ChannelClass::kState}) {
+      if (written_[index(c)] > 0) {
+        dds_wait_for_acks(writers_[index(c)], std::max<dds_duration_t>(0, deadline - dds_time()));
+      }
+    }
     dds_delete(participant_);  // and every reader, writer, topic and the waitset in it
     subscriptions_.clear();
     release_domain(domain_id_);
@@ -191,7 +204,9 @@ class DdsTransport final : public Transport {
     msg.data._length = static_cast<std::uint32_t>(size);
     msg.data._maximum = static_cast<std::uint32_t>(size);
     msg.data._release = false;
-    const dds_return_t rc = dds_write(writers_[index(channels::channel_class(channel))], &msg);
+    const ChannelClass channel_class = channels::channel_class(channel);
+    const dds_return_t rc = dds_write(writers_[index(channel_class)], &msg);
+    ++written_[index(channel_class)];
     if (rc == DDS_RETCODE_TIMEOUT) {
       throw TransportError("DDS publish on channel " + channel + " (" + std::to_string(size) +
                            " bytes) timed out: a reader does not keep up (back-pressure)");
@@ -379,6 +394,7 @@ class DdsTransport final : public Transport {
   dds_entity_t participant_ = 0;
   dds_entity_t waitset_ = 0;
   std::array<dds_entity_t, 4> writers_{};
+  std::array<std::int64_t, 4> written_{};  ///< samples written per class (acks awaited at close)
   std::map<SubscriptionId, std::unique_ptr<Subscription>> subscriptions_;
   std::vector<std::pair<SubscriptionId, dds_entity_t>> readers_;
   std::size_t next_reader_ = 0;

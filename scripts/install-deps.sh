@@ -11,8 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # LCM tools, Java bindings for lcm-spy, DDS tools
   liblcm-bin liblcm-java libjchart2d-java default-jdk-headless cyclonedds-tools
-  # network namespaces (unshare, nsenter, ip) and process tools
-  util-linux iproute2 procps
+  # network namespaces (unshare, nsenter, ip), packet loss inside them (nft), process tools
+  util-linux iproute2 nftables procps
   # plots
   python3 python3-matplotlib python3-numpy
 )

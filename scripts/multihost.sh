@@ -1,0 +1,314 @@
+#!/usr/bin/env bash
+# The training system on three "hosts": network namespaces A, B and C (10.77.0.1-3/24), each
+# joined by a veth pair to a Linux bridge in a fourth namespace. Nothing touches the host's
+# network: every namespace, link, address, route and nftables rule is created inside a private
+# network + PID + mount namespace of this script's own, and vanishes with it (the kernel ends
+# every process left in it when the script ends, whatever the reason).
+#
+#   A: auv_sim (vehicle 0) + auv_actor 0 (a lockstep pair stays on one host), probe
+#   B: auv_learner, probe
+#   C: auv_logger, auv_sim (vehicle 1) + auv_actor 1, probe
+# (the probe, build/bin/multihost_probe, counts what reaches its namespace)
+#
+#   scripts/multihost.sh [--transport dds|lcm] [--links no-multicast|multicast] [--lcm-ttl N]
+#                        [--loss PCT] [--seconds S] [--hidden H] [--out DIR] [--check]
+#   scripts/multihost.sh --ci       the CTest form (test_multihost): DDS with --loss 5 --check,
+#                                   then LCM on the same links, where nothing may cross
+#
+# --links no-multicast (default): `ip link set eth0 multicast off` on every link, no multicast
+#   route on them (224.0.0.0/4 goes to lo, as in every private namespace of this project, so
+#   that LCM can start at all); multicast: multicast on, 224.0.0.0/4 routed over the link (LCM
+#   then also needs --lcm-ttl 1: with the default ttl=0 nothing leaves a namespace).
+# --loss PCT: each namespace drops PCT % of the UDP frames (IP packets, fragments included)
+#   that arrive over its link, with nftables (numgen random), because this kernel has no netem
+#   ("tc qdisc add dev eth0 root netem loss 5%" -> "Error: Specified qdisc kind is unknown.").
+#   Only traffic from the other namespaces is dropped; the namespace's own looped-back
+#   multicast is not.
+# --check: exit 1 unless the run delivered what the transport promises (DDS: every transition
+#   sent reached the learner, the newest weights reached both actor namespaces, episodes and
+#   updates happened, the logger logged every episode; LCM with --links no-multicast: nothing
+#   crossed a link). Exit 77 when namespaces cannot be made (no root, no user namespaces).
+#
+# Figures: the probes' lines (multihost_probe.cpp), the logger's channel counts (auv_log list)
+# and a summary; everything stays in DIR (default runs/multihost-TIME) with the logs.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+bin=${AUVRL_BIN_DIR:-$root/build/bin}
+self=$(readlink -f "$0")
+usage() { sed -n '2,36p' "$self" | sed 's/^# \{0,1\}//'; exit 2; }
+
+transport=dds links=no-multicast ttl=0 loss=0 seconds=20 hidden=32-32 out="" check=0 ci=0
+inside=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --transport) transport=$2; shift 2 ;;
+    --links) links=$2; shift 2 ;;
+    --lcm-ttl) ttl=$2; shift 2 ;;
+    --loss) loss=$2; shift 2 ;;
+    --seconds) seconds=$2; shift 2 ;;
+    --hidden) hidden=$2; shift 2 ;;
+    --out) out=$2; shift 2 ;;
+    --check) check=1; shift ;;
+    --ci) ci=1; shift ;;
+    --inside) inside=1; shift ;;
+    -h|--help) usage ;;
+    *) echo "multihost: unknown argument '$1'" >&2; usage ;;
+  esac
+done
+case "$transport" in dds|lcm) ;; *) usage ;; esac
+case "$links" in no-multicast|multicast) ;; *) usage ;; esac
+for b in auv_sim auv_actor auv_learner auv_logger auv_log multihost_probe; do
+  [ -x "$bin/$b" ] || { echo "multihost: $bin/$b is missing (build it first)" >&2; exit 1; }
+done
+
+# --- The CI form: two runs, each in namespaces of its own. ---------------------------------
+if [ "$ci" = 1 ]; then
+  base=${out:-$(mktemp -d /tmp/auvrl_multihost_XXXXXX)}
+  status=0
+  "$self" --transport dds --loss 5 --seconds 20 --check --out "$base/dds" || status=$?
+  [ "$status" = 0 ] || exit "$status"
+  "$self" --transport lcm --seconds 8 --check --out "$base/lcm" || status=$?
+  [ "$status" = 0 ] && rm -rf "$base"
+  exit "$status"
+fi
+
+# --- Outside: a private network, PID and mount namespace for everything below. -------------
+if [ "$inside" = 0 ]; then
+  out=${out:-$root/runs/multihost-$(date +%Y%m%d-%H%M%S)}
+  mkdir -p "$out"
+  out=$(cd "$out" && pwd)
+  flags=(-n -p -m --fork --mount-proc --kill-child=KILL)
+  [ "$(id -u)" -eq 0 ] || flags=(-r "${flags[@]}")  # a user namespace maps us to root inside
+  if ! unshare "${flags[@]}" true 2>/dev/null; then
+    echo "multihost: cannot create namespaces here (needs root or user namespaces); skipped" >&2
+    exit 77
+  fi
+  check_flag=()
+  [ "$check" = 0 ] || check_flag=(--check)
+  unshare "${flags[@]}" -- "$self" --inside --transport "$transport" --links "$links" \
+    --lcm-ttl "$ttl" --loss "$loss" --seconds "$seconds" --hidden "$hidden" --out "$out" \
+    "${check_flag[@]}" &
+  unshare_pid=$!
+  # unshare ignores SIGTERM/SIGINT while it waits: pass them to PID 1 inside, which stops
+  # what it started; when PID 1 ends, the kernel ends every process left in its namespace
+  # (and --kill-child ends PID 1 if unshare itself is killed).
+  inner=""
+  for _ in $(seq 1 200); do
+    inner=$(pgrep -P "$unshare_pid" || true)
+    [ -n "$inner" ] && break
+    kill -0 "$unshare_pid" 2>/dev/null || break
+    sleep 0.01
+  done
+  trap '[ -n "$inner" ] && kill -TERM "$inner" 2>/dev/null || true' TERM INT HUP
+  status=0
+  while true; do
+    wait "$unshare_pid" && status=0 || status=$?
+    kill -0 "$unshare_pid" 2>/dev/null || break
+  done
+  exit "$status"
+fi
+
+# --- Inside: PID 1 of the private namespaces, in the bridge's network namespace. -----------
+# Refuse to go on unless unshare made us PID 1 of new namespaces (never on the host's network).
+[ "$$" = 1 ] || { echo "multihost: not PID 1 of a private namespace; refused" >&2; exit 1; }
+
+pids=()
+# shellcheck disable=SC2317  # called by the trap
+cleanup() {
+  # Everything this script started, newest first; the kernel ends the rest when PID 1 exits.
+  local i
+  for ((i = ${#pids[@]} - 1; i >= 0; i--)); do kill -TERM "${pids[$i]}" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+log() { echo "multihost: $*" >&2; }
+names=(A B C)
+declare -A holder addr
+ip link set lo up
+ip link add br0 type bridge mcast_snooping 0
+ip link set br0 up
+for i in 0 1 2; do
+  n=${names[$i]}
+  addr[$n]=10.77.0.$((i + 1))
+  # A process that holds namespace n open (the processes placed there join it with nsenter).
+  unshare -n sleep infinity &
+  holder[$n]=$!
+  pids+=("$!")
+  for _ in $(seq 1 100); do
+    [ "$(readlink "/proc/${holder[$n]}/ns/net")" != "$(readlink /proc/self/ns/net)" ] && break
+    sleep 0.01
+  done
+  ip link add "v$n" type veth peer name eth0 netns "${holder[$n]}"
+  ip link set "v$n" master br0
+  ip link set "v$n" up
+  in_ns() { nsenter -t "${holder[$n]}" -n -- "$@"; }
+  in_ns ip link set lo up
+  in_ns ip link set lo multicast on
+  in_ns ip addr add "${addr[$n]}/24" dev eth0
+  in_ns ip link set eth0 up
+  if [ "$links" = multicast ]; then
+    in_ns ip link set eth0 multicast on
+    in_ns ip route add 224.0.0.0/4 dev eth0
+  else
+    in_ns ip link set eth0 multicast off
+    ip link set "v$n" multicast off
+    in_ns ip route add 224.0.0.0/4 dev lo
+  fi
+  if [ "$loss" != 0 ]; then
+    # Before defragmentation (priority -500): every frame is lost on its own, as on a wire.
+    in_ns nft -f - <<EOF
+table inet auvrl_loss {
+  chain in {
+    type filter hook prerouting priority -500; policy accept;
+    iifname "eth0" ip saddr != ${addr[$n]} meta l4proto udp numgen random mod 100 < $loss drop
+  }
+}
+EOF
+  fi
+done
+if [ "$loss" != 0 ]; then
+  netem_error=$(nsenter -t "${holder[A]}" -n -- tc qdisc add dev eth0 root netem loss "$loss%" \
+    2>&1 && nsenter -t "${holder[A]}" -n -- tc qdisc del dev eth0 root) || true
+  log "loss ${loss}% by nftables in each namespace (tc netem: ${netem_error:-available})"
+fi
+log "links: $links; A ${addr[A]}, B ${addr[B]}, C ${addr[C]} on br0"
+nsenter -t "${holder[A]}" -n -- ip -br link show eth0 >"$out/links.txt"
+nsenter -t "${holder[A]}" -n -- ip route show table all type multicast >>"$out/links.txt" || true
+nsenter -t "${holder[A]}" -n -- ip route >>"$out/links.txt"
+
+# Transport flags. Over DDS every namespace lists all three addresses (unicast discovery; its
+# own reaches its local participants). --allow-off-host: the peers are not loopback addresses,
+# which the processes refuse by default because the bus has no authentication; here that is
+# correct, since these addresses exist only on the veth links of this script's private
+# namespaces and no packet can reach a real network.
+if [ "$transport" = dds ]; then
+  common=(--transport dds --dds-peers "${addr[A]},${addr[B]},${addr[C]}" --allow-off-host)
+  lockstep_a=(--lockstep-dds-domain 1)
+  lockstep_c=(--lockstep-dds-domain 2)
+else
+  common=(--transport lcm --lcm-url "udpm://239.255.76.67:7667?ttl=$ttl&recv_buf_size=8388608")
+  [ "$ttl" = 0 ] || common+=(--allow-off-host)  # same reason as for DDS above
+  lockstep_a=(--lockstep-lcm-url "udpm://239.255.76.67:7668?ttl=0")
+  lockstep_c=(--lockstep-lcm-url "udpm://239.255.76.67:7669?ttl=0")
+fi
+
+declare -A pid_of
+start() {  # start NAME NAMESPACE CMD...: runs CMD in NAMESPACE, output in $out/NAME.log
+  local name=$1 ns=$2
+  shift 2
+  nsenter -t "${holder[$ns]}" -n -- "$@" >"$out/$name.log" 2>&1 &
+  pid_of[$name]=$!
+  pids+=("$!")
+}
+stop() {  # stop NAME...: SIGTERM, then wait up to 10 s (SIGKILL after)
+  local name p
+  for name in "$@"; do kill -TERM "${pid_of[$name]}" 2>/dev/null || true; done
+  for name in "$@"; do
+    p=${pid_of[$name]}
+    for _ in $(seq 1 100); do kill -0 "$p" 2>/dev/null || break; sleep 0.1; done
+    kill -KILL "$p" 2>/dev/null || true
+    wait "$p" 2>/dev/null || true
+  done
+}
+
+for n in A B C; do
+  start "probe$n" "$n" "$bin/multihost_probe" --label "$n" --out "$out/probe$n.txt" "${common[@]}"
+done
+start learner B "$bin/auv_learner" "${common[@]}" --algo td3 --hidden "$hidden" --batch 64 \
+  --state-dim 23 --replay 100000 --updates-per-transition 0.25 --warmup 500
+start logger C "$bin/auv_logger" "${common[@]}" --dir "$out/logs" --heartbeat-period 0.5 \
+  --channels 'EXPERIENCE|EPISODE|POLICY_.*|LEARNER_STATS|SIM_HEARTBEAT'
+start simA A "$bin/auv_sim" "${common[@]}" "${lockstep_a[@]}" --vehicles 1 --first-vehicle-id 0
+start simC C "$bin/auv_sim" "${common[@]}" "${lockstep_c[@]}" --vehicles 1 --first-vehicle-id 1
+actor_args=(--layout extended --reward shaped --max-steps 100 --noise gaussian)
+start actorA A "$bin/auv_actor" "${common[@]}" "${lockstep_a[@]}" --actor-id 0 --seed 10 \
+  "${actor_args[@]}"
+start actorC C "$bin/auv_actor" "${common[@]}" "${lockstep_c[@]}" --actor-id 1 --seed 11 \
+  "${actor_args[@]}"
+log "$transport: training for ${seconds} s (logs in $out)"
+sleep "$seconds" &
+wait $!  # (a signal's trap runs at once)
+# Actors first (over DDS an exiting process waits until its experience is acknowledged), then
+# time for the learner's next figures (once a second) to arrive; then the learner (over DDS it
+# waits until its newest weights are acknowledged), and the probes write what they counted.
+stop actorA actorC
+sleep 3
+stop learner
+sleep 1
+stop probeA probeB probeC
+stop simA simC logger
+"$bin/auv_log" list "$out/logs" >"$out/logger_channels.txt" 2>&1 || true
+for n in A B C; do  # what went over each link (the namespace's end of it)
+  echo "namespace $n:"
+  nsenter -t "${holder[$n]}" -n -- ip -s link show eth0
+  nsenter -t "${holder[$n]}" -n -- nft list ruleset 2>/dev/null || true
+done >>"$out/links.txt"
+
+# --- Figures. --------------------------------------------------------------------------------
+cat "$out"/probe{A,B,C}.txt
+echo "logger (namespace C), auv_log list:"
+sed 's/^/  /' "$out/logger_channels.txt"
+field() {  # field FILE LINE_PATTERN KEY: the KEY=value on the first line matching the pattern
+  local v
+  v=$(grep -E "$2" "$1" 2>/dev/null | head -1 | tr ' ' '\n' | sed -n "s/^$3=//p")
+  echo "${v:-0}"
+}
+sent_a=$(field "$out/probeA.txt" "experience actor=0 " transitions)
+sent_c=$(field "$out/probeC.txt" "experience actor=1 " transitions)
+received=$(field "$out/probeB.txt" "learner " transitions_received)
+lost=$(field "$out/probeB.txt" "learner " batches_lost)
+updates=$(field "$out/probeB.txt" "learner " updates)
+learner_episodes=$(field "$out/probeB.txt" "learner " episodes)
+published=$(field "$out/probeB.txt" "learner " weights_published)
+newest=$(field "$out/probeB.txt" "weights " newest)  # B: beside the learner, nothing lost
+episodes_a=$(field "$out/probeA.txt" "episodes actor=0 " count)
+episodes_c=$(field "$out/probeC.txt" "episodes actor=1 " count)
+policy_a=$(field "$out/probeB.txt" "episodes actor=0 " policy_last)
+policy_c=$(field "$out/probeB.txt" "episodes actor=1 " policy_last)
+weights_a=$(field "$out/probeA.txt" "weights " versions)
+weights_c=$(field "$out/probeC.txt" "weights " versions)
+newest_a=$(field "$out/probeA.txt" "weights " newest)
+newest_c=$(field "$out/probeC.txt" "weights " newest)
+bytes=$(field "$out/probeB.txt" "weights " bytes)
+logged_episodes=$(awk '$1 == "EPISODE" {print $2}' "$out/logger_channels.txt" | head -1)
+logged_episodes=${logged_episodes:-0}
+logged_stats=$(awk '$1 == "LEARNER_STATS" {print $2}' "$out/logger_channels.txt" | head -1)
+logged_stats=${logged_stats:-0}
+pct() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.1f", 100 * a / b; else print "-" }'; }
+cat <<EOF
+summary transport=$transport links=$links lcm_ttl=$ttl loss=${loss}% seconds=$seconds hidden=$hidden weights_bytes=$bytes
+  experience: sent A=$sent_a C=$sent_c, learner received $received ($(pct "$received" $((sent_a + sent_c)))%), batches lost (seq gaps) $lost
+  episodes: A=$episodes_a C=$episodes_c, learner counted $learner_episodes, logger (C) logged $logged_episodes (and $logged_stats LEARNER_STATS)
+  updates $updates, weights published $published (newest version $newest)
+  weights versions received: A $weights_a ($(pct "$weights_a" "$published")%) newest $newest_a, C $weights_c ($(pct "$weights_c" "$published")%) newest $newest_c
+  policy version of the last episode seen by the learner: actor 0 (A) $policy_a, actor 1 (C) $policy_c
+EOF
+
+[ "$check" = 1 ] || exit 0
+fail=0
+expect() {  # expect DESCRIPTION TEST...
+  local what=$1
+  shift
+  if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; fail=1; fi
+}
+if [ "$transport" = dds ]; then
+  expect "both actors sent experience" test "$sent_a" -gt 0 -a "$sent_c" -gt 0
+  expect "every transition sent reached the learner" test "$received" -eq $((sent_a + sent_c))
+  expect "no experience batch lost" test "$lost" -eq 0
+  expect "every episode reached the learner" test "$learner_episodes" -eq $((episodes_a + episodes_c))
+  expect "the learner updated and published weights" test "$updates" -gt 0 -a "$published" -gt 0
+  expect "the newest weights reached A and C" test "$newest_a" -eq "$newest" -a "$newest_c" -eq "$newest"
+  expect "both actors acted with the learner's weights" test "$policy_a" -gt 0 -a "$policy_c" -gt 0
+  expect "the logger logged every episode" test "$logged_episodes" -eq $((episodes_a + episodes_c))
+elif [ "$links" = no-multicast ]; then
+  expect "the actors ran" test "$sent_a" -gt 0 -a "$sent_c" -gt 0
+  expect "no experience crossed to the learner" test "$received" -eq 0
+  expect "no weights crossed to A or C" test "$weights_a" -eq 0 -a "$weights_c" -eq 0
+  expect "the logger (C) logged only C's episodes" test "$logged_episodes" -eq "$episodes_c"
+  expect "the logger (C) logged no learner figures" test "$logged_stats" -eq 0
+else
+  expect "experience crossed to the learner" test "$received" -gt 0
+  expect "weights crossed to A and C" test "$weights_a" -gt 0 -a "$weights_c" -gt 0
+fi
+exit "$fail"
