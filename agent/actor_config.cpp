@@ -28,6 +28,10 @@ void read_actor_config_file(const std::string& path, ActorNodeConfig& c) {
   s.read("max_episodes", c.max_episodes);
   s.read("max_learner_backlog", c.max_learner_backlog);
   s.read("max_wait_s", c.max_wait_s);
+  s.read("lockstep_timeout_ms", c.lockstep.timeout_ms);
+  s.read("lockstep_attempts", c.lockstep.attempts);
+  if (c.lockstep.timeout_ms < 1) s.fail("lockstep_timeout_ms", "must be >= 1");
+  if (c.lockstep.attempts < 1) s.fail("lockstep_attempts", "must be >= 1");
   s.finish();
   config::finish_run_file(root);
 }

@@ -38,7 +38,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       transport_(transport),
       log_(log),
       link_(make_lockstep_link(lockstep_transport ? *lockstep_transport : transport,
-                               config_.vehicle_id, config_.task.num_thrusters)),
+                               config_.vehicle_id, config_.task.num_thrusters, config_.lockstep)),
       weights_(transport, channels::kPolicyWeights, 8),
       controller_(std::make_unique<ExploringController>(*this)),
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,

@@ -38,6 +38,10 @@ struct ActorNodeConfig {
   /// (0: never wait). Keeps the update-to-data ratio when actors outrun the learner.
   double max_learner_backlog = 0.0;
   double max_wait_s = 5.0;  ///< ...but never longer than this (a learner that went away)
+  /// Lockstep: a step unanswered within timeout_ms is sent again (the simulator answers a
+  /// repeated command with the state it already computed), up to attempts times; then the
+  /// episode ends (END_SIM_TIMEOUT). Each lost datagram costs one timeout_ms.
+  LockstepTiming lockstep;
 };
 
 /// Counters for logs and tests.

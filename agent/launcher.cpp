@@ -1,14 +1,18 @@
 #include "agent/launcher.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/logger_heartbeat_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
 #include <auvrl_lcm/sim_heartbeat_t.hpp>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +20,7 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "agent/evaluation.hpp"
@@ -65,6 +70,7 @@ RunConfig read_run_config(const std::string& path) {
   run.read("private_lockstep_bus", c.run.private_lockstep_bus);
   run.read("max_restarts", c.run.max_restarts);
   run.read("restart_window_s", c.run.restart_window_s);
+  run.read("heartbeat_timeout_s", c.run.heartbeat_timeout_s);
   run.finish();
   transport::read_transport_section(root.child("transport"), c.transport);
   return c;
@@ -92,6 +98,7 @@ struct Role {
   Clock::time_point restart_due{};
   bool waiting_restart = false;
   bool finished = false;  ///< ended by itself, successfully, and should stay ended
+  int actor_id = -1;      ///< an actor's id (its signs of life are its EPISODE reports)
 };
 
 /// A quick score of a policy: reached count first, then faster and closer holding.
@@ -249,12 +256,16 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   const auto start = Clock::now();
   const auto wall = [&] { return trained_before_s + seconds_since(start); };
 
+  // Signs of life for the hang watch (RunSettings::heartbeat_timeout_s): the time of the last
+  // heartbeat by process id (simulators, logger, learner) and of the last episode by actor id.
+  std::map<int, Clock::time_point> alive_by_pid, alive_by_actor;
   std::deque<bool> recent_success;
   std::int64_t episodes_seen = 0;
   double beta_m = 0;
   transport::subscribe<auvrl_lcm::episode_report_t>(
       *transport, channels::kEpisode,
       [&](const std::string&, const auvrl_lcm::episode_report_t& e) {
+        alive_by_actor[e.actor_id] = Clock::now();
         ++episodes_seen;
         beta_m = e.beta_m;
         recent_success.push_back(e.success);
@@ -270,6 +281,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   transport::subscribe<auvrl_lcm::learner_stats_t>(
       *transport, channels::kLearnerStats,
       [&](const std::string&, const auvrl_lcm::learner_stats_t& s) {
+        alive_by_pid[s.pid] = Clock::now();
         last_stats = s;
         learner_episodes = s.episodes;
         learner_csv << std::fixed << std::setprecision(3) << wall() << ',' << s.updates << ','
@@ -283,7 +295,13 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *transport, channels::kSimHeartbeat,
       [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
+        alive_by_pid[h.pid] = Clock::now();
         sim_steps[h.pid] = {h.steps_per_s, h.steps_total};
+      });
+  transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
+      *transport, channels::kLoggerHeartbeat,
+      [&](const std::string&, const auvrl_lcm::logger_heartbeat_t& h) {
+        alive_by_pid[h.pid] = Clock::now();
       });
   transport::Latest<auvrl_lcm::policy_weights_t> weights(*transport, channels::kPolicyWeights, 4);
 
@@ -350,7 +368,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     const std::uint64_t seed = rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
     const int cpu = actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()];
     const std::vector<std::string> bus = lockstep_args(i);
-    actor_roles.push_back(add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
+    Role* actor = add_role("actor" + std::to_string(i), [=](std::size_t restarts) {
       // A restarted actor explores anew rather than repeating its first life.
       std::vector<std::string> argv = {bin + "auv_actor",
                                        "--config",
@@ -367,12 +385,17 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                                        "100"};
       argv.insert(argv.end(), bus.begin(), bus.end());
       return with_transport(argv);
-    }));
+    });
+    actor->actor_id = i;
+    actor_roles.push_back(actor);
   }
   const auto start_role = [&](Role& r, bool resume_learner) {
     std::vector<std::string> argv = r.argv(r.restarts.size());
     if (&r == learner && resume_learner) argv.push_back("--resume");
     r.proc = std::make_unique<process::ChildProcess>(argv, r.log_path, true);
+    // The new process is watched from its own first sign of life on.
+    alive_by_pid.erase(r.proc->pid());
+    if (r.actor_id >= 0) alive_by_actor.erase(r.actor_id);
     // PID in the run's namespace, for tools and tests started in that namespace.
     std::ofstream((proc_dir / (r.name + ".pid")).string()) << r.proc->pid() << "\n";
   };
@@ -418,7 +441,21 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         }
         continue;
       }
-      if (r->proc->running()) continue;
+      if (r->proc->running()) {
+        // Hang watch: silent too long after its first sign of life -> SIGKILL; the restart
+        // below follows once it is reaped.
+        auto& alive = r->actor_id >= 0 ? alive_by_actor : alive_by_pid;
+        const auto seen = alive.find(r->actor_id >= 0 ? r->actor_id : r->proc->pid());
+        if (rc.run.heartbeat_timeout_s > 0 && seen != alive.end() &&
+            seconds_since(seen->second) > rc.run.heartbeat_timeout_s) {
+          out << (tty ? "\n" : "") << "auvrl train: " << r->name << " silent for "
+              << std::lround(seconds_since(seen->second))
+              << " s (no heartbeat; hung?); killing it\n";
+          alive.erase(seen);
+          r->proc->signal(SIGKILL);
+        }
+        continue;
+      }
       const int status = r->proc->wait_for_exit(std::chrono::milliseconds(0));
       const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
       if (r.get() == learner && clean) {
@@ -461,6 +498,10 @@ int run_training(const TrainOptions& options, std::ostream& out) {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
           const QuickScore score = quick_evaluate(model, rc.task, net, rc.run.best_eval_suite);
+          // The launcher did not listen meanwhile: nobody counts as silent for that time.
+          for (auto* alive : {&alive_by_pid, &alive_by_actor}) {
+            for (auto& entry : *alive) entry.second = Clock::now();
+          }
           if (best_version < 0 || score.better_than(best)) {
             best = score;
             best_version = w->version;
@@ -495,9 +536,23 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                    << std::setprecision(0) << steps_per_s << ',' << updates_per_s << ','
                    << (best_version < 0 ? 0.0 : static_cast<double>(best.reached) / best.episodes)
                    << '\n';
+      errno = 0;
       progress_csv.flush();
       episodes_csv.flush();
       learner_csv.flush();
+      // Disk full or run directory not writable: stop with the path named; the checkpoints
+      // already written stay intact (the learner writes each to a new file and renames it).
+      if (!progress_csv || !episodes_csv || !learner_csv) {
+        const char* file = !progress_csv   ? "progress.csv"
+                           : !episodes_csv ? "episodes.csv"
+                                           : "learner.csv";
+        stop_reason = "cannot write " + (run_dir / file).string() + " (" +
+                      (errno != 0 ? std::strerror(errno) : "write error") +
+                      "): disk full or run directory not writable; the last checkpoint in " +
+                      (run_dir / "checkpoints").string() + " is kept";
+        exit_code = 1;
+        break;
+      }
       std::ostringstream line;
       line << std::fixed << "episodes " << learner_episodes << "  success(100) "
            << std::setprecision(0) << 100 * success_rate << "%  beta " << std::setprecision(2)

@@ -27,6 +27,11 @@ struct RunSettings {
   bool private_lockstep_bus = true;
   int max_restarts = 5;             ///< a role restarted more often than this within...
   double restart_window_s = 120.0;  ///< ...this many seconds stops the run
+  /// A process silent for this long after its first sign of life is taken as hung, killed
+  /// (SIGKILL) and restarted like a crashed one, s (0: not watched). Signs of life: the
+  /// simulator's SIM_HEARTBEAT, the logger's LOGGER_HEARTBEAT, the learner's LEARNER_STATS
+  /// (each ~1 Hz) and an actor's EPISODE reports.
+  double heartbeat_timeout_s = 60.0;
 };
 
 /// What `auvrl train` was asked.

@@ -56,8 +56,9 @@ class InProcessLink final : public VehicleLink {
 
 class LockstepLink final : public VehicleLink {
  public:
-  LockstepLink(transport::Transport& transport, int vehicle_id, int num_thrusters)
-      : client_(transport, vehicle_id), num_thrusters_(num_thrusters) {}
+  LockstepLink(transport::Transport& transport, int vehicle_id, int num_thrusters,
+               LockstepTiming timing)
+      : client_(transport, vehicle_id, timing), num_thrusters_(num_thrusters) {}
   int num_thrusters() const override { return num_thrusters_; }
 
   std::optional<VehicleReport> reset(const EpisodeStart& start) override {
@@ -104,8 +105,8 @@ std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model
 }
 
 std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
-                                                int num_thrusters) {
-  return std::make_unique<LockstepLink>(transport, vehicle_id, num_thrusters);
+                                                int num_thrusters, LockstepTiming timing) {
+  return std::make_unique<LockstepLink>(transport, vehicle_id, num_thrusters, timing);
 }
 
 }  // namespace auvrl::agent

@@ -8,6 +8,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/sim_client.hpp"
 #include "common/task/task.hpp"
 #include "common/transport.hpp"
 #include "sim/dynamics.hpp"
@@ -43,8 +44,9 @@ class VehicleLink {
 /// The dynamics library in this process (deterministic, no transport).
 std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model);
 
-/// One vehicle of auv_sim over the transport, in lockstep.
+/// One vehicle of auv_sim over the transport, in lockstep; a step or reset unanswered within
+/// timing.timeout_ms is sent again, up to timing.attempts times, then reported as lost.
 std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
-                                                int num_thrusters);
+                                                int num_thrusters, LockstepTiming timing = {});
 
 }  // namespace auvrl::agent

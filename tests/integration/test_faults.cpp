@@ -1,0 +1,248 @@
+// Faults under auvrl train (a real run of the fast preset over LCM, inside this test's private
+// network namespace), in the order a run meets them: kill -9 of a simulator and of the logger,
+// a simulator and the learner that hang (SIGSTOP) and are noticed by their missing heartbeat,
+// an actor that hangs. After each the role is back and working; the learner resumes exactly
+// the newest checkpoint (update count and replay content as the file holds them); the log
+// files the killed logger wrote are readable to their last complete event. test_launcher
+// covers kill -9 of an actor and of the learner over both transports.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "child_process.hpp"
+#include "common/transport.hpp"
+#include "learner/checkpoint.hpp"
+#include "learner/learner_config.hpp"
+#include "learner/learner_node.hpp"
+#include "logger/event_log.hpp"
+
+namespace {
+
+using namespace auvrl;
+namespace fs = std::filesystem;
+using test_support::ChildProcess;
+
+const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+constexpr int kEndSimTimeout = 5;  // episode_report_t::END_SIM_TIMEOUT
+
+std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+  const auto split = [](const std::string& text) {
+    std::vector<std::string> cells;
+    std::stringstream ss(text);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    return cells;
+  };
+  if (std::getline(in, line)) header = split(line);
+  while (std::getline(in, line)) {
+    const auto cells = split(line);
+    if (cells.size() != header.size()) continue;  // a row being written
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+int read_pid(const fs::path& path) {
+  std::ifstream in(path);
+  int pid = -1;
+  in >> pid;
+  return pid;
+}
+
+bool wait_for(const std::function<bool()>& condition, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    if (condition()) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return condition();
+}
+
+/// The fast preset with checkpoints every 2 s and a hang watch of 8 s; no quick evaluations.
+std::string faults_config(const std::string& dir) {
+  std::ifstream in(kPreset);
+  const std::string path = dir + "/fast_faults.yaml";
+  std::ofstream out(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) == 0) {
+      line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+    } else if (line.find("checkpoint_period_s:") != std::string::npos) {
+      line = "  checkpoint_period_s: 2";
+    } else if (line.rfind("run:", 0) == 0) {
+      line += "\n  heartbeat_timeout_s: 8\n  best_eval_period_s: 100000";
+    }
+    out << line << "\n";
+  }
+  return path;
+}
+
+/// Whether actor `id` finished an episode that really stepped (not ended by a lockstep
+/// timeout) after wall time `after` (the run's wall_s).
+bool actor_stepped_after(const fs::path& run, const std::string& id, double after) {
+  for (const auto& row : read_csv(run / "episodes.csv")) {
+    if (row.at("actor_id") == id && std::atof(row.at("wall_s").c_str()) > after &&
+        std::atoi(row.at("end_reason").c_str()) != kEndSimTimeout) {
+      return true;
+    }
+  }
+  return false;
+}
+
+double last_wall(const fs::path& run) {
+  const auto rows = read_csv(run / "episodes.csv");
+  return rows.empty() ? 0.0 : std::atof(rows.back().at("wall_s").c_str());
+}
+
+std::vector<fs::path> log_files(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".lcmlog") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+TEST(LauncherFaults, KilledAndHungProcessesComeBackAndNothingIsLost) {
+  const std::string tmp = test_support::make_temp_dir("auvrl_faults_");
+  const std::string dir = tmp + "/run";
+  const fs::path run(dir);
+  ChildProcess train(
+      {test_support::bin_path("auvrl"), "train", "--config", faults_config(tmp), "--run-dir", dir,
+       "--network", "host", "--actors", "2", "--max-seconds", "240", "--no-eval"},
+      dir + ".log");
+  const auto pid_of = [&](const std::string& role) {
+    return read_pid(run / "processes" / (role + ".pid"));
+  };
+  const auto launcher_says = [&](const std::string& text) {
+    return train.log().find(text) != std::string::npos;
+  };
+  ASSERT_TRUE(wait_for([&] { return read_csv(run / "episodes.csv").size() >= 10; }, 60))
+      << train.log();
+
+  // kill -9 of a simulator: restarted; its actor times out its step, resets and steps again.
+  {
+    const int sim = pid_of("sim0");
+    const double at = last_wall(run);
+    ASSERT_EQ(kill(sim, SIGKILL), 0);
+    EXPECT_TRUE(wait_for([&] { return launcher_says("sim0 ended (signal 9); restarting"); }, 10))
+        << train.log();
+    EXPECT_TRUE(wait_for([&] { return actor_stepped_after(run, "0", at + 1.0); }, 30))
+        << train.log();
+    EXPECT_NE(pid_of("sim0"), sim);
+  }
+
+  // kill -9 of the logger: restarted, writing a new file; what it wrote before is readable to
+  // its last complete event (damage, if any, only at the very end of the last file).
+  {
+    const std::vector<fs::path> before = log_files(run / "logs");
+    ASSERT_FALSE(before.empty());
+    ASSERT_EQ(kill(pid_of("logger"), SIGKILL), 0);
+    EXPECT_TRUE(wait_for([&] { return launcher_says("logger ended (signal 9); restarting"); }, 10))
+        << train.log();
+    EXPECT_TRUE(wait_for([&] { return log_files(run / "logs").size() > before.size(); }, 15))
+        << "the restarted logger starts a new file";
+    for (const fs::path& file : before) {
+      logger::LogReader reader(file.string());
+      logger::LogEvent event;
+      std::int64_t events = 0;
+      while (reader.next(event)) ++events;
+      EXPECT_GT(events, 0) << file;
+      ASSERT_LE(reader.damage().size(), 1u) << file;
+      if (!reader.damage().empty()) {
+        const logger::LogDamage& d = reader.damage().front();
+        EXPECT_EQ(file, before.back()) << "only the file being written can be torn";
+        EXPECT_EQ(d.offset + d.bytes_skipped, reader.file_size()) << file << ": " << d.what;
+      }
+    }
+  }
+
+  // A simulator that hangs: its heartbeat stops, the launcher kills and restarts it.
+  {
+    const int sim = pid_of("sim1");
+    const double at = last_wall(run);
+    ASSERT_EQ(kill(sim, SIGSTOP), 0);
+    EXPECT_TRUE(wait_for([&] { return launcher_says("sim1 silent for"); }, 20)) << train.log();
+    EXPECT_TRUE(wait_for([&] { return launcher_says("sim1 ended (signal 9); restarting"); }, 10))
+        << train.log();
+    EXPECT_TRUE(wait_for([&] { return actor_stepped_after(run, "1", at + 1.0); }, 30))
+        << train.log();
+  }
+
+  // The learner hangs after a checkpoint: frozen, its newest checkpoint is final; the launcher
+  // notices, kills it and the new learner resumes exactly that checkpoint.
+  {
+    ASSERT_TRUE(
+        wait_for([&] { return !learner::list_checkpoints(dir + "/checkpoints").empty(); }, 30));
+    ASSERT_EQ(kill(pid_of("learner"), SIGSTOP), 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // a rename under way lands
+    const learner::CheckpointFile newest = learner::list_checkpoints(dir + "/checkpoints").front();
+    const std::string copy_dir = tmp + "/checkpoint_copy";
+    fs::create_directories(copy_dir);
+    fs::copy_file(newest.path, fs::path(copy_dir) / fs::path(newest.path).filename());
+
+    EXPECT_TRUE(wait_for([&] { return launcher_says("learner silent for"); }, 20)) << train.log();
+    std::smatch m;
+    const std::regex resumed("resumed from (\\S+) \\((\\d+) updates, (\\d+) transitions");
+    ASSERT_TRUE(wait_for(
+        [&] {
+          const std::string log = read_text(run / "processes" / "learner.log");
+          return std::regex_search(log, m, resumed) && m[1] == newest.path;
+        },
+        40))
+        << train.log() << read_text(run / "processes" / "learner.log");
+    const std::int64_t resumed_updates = std::stoll(m[2]);
+    const std::int64_t resumed_transitions = std::stoll(m[3]);
+    EXPECT_EQ(resumed_updates, newest.updates);
+
+    // What the checkpoint holds, read in this process.
+    learner::LearnerNodeConfig config;
+    learner::read_learner_config_file(dir + "/config.yaml", config);
+    config.checkpoint_dir = copy_dir;
+    config.max_actors = 2;
+    auto transport = transport::make_in_process_transport();
+    std::ostringstream log;
+    learner::LearnerNode node(config, *transport, log);
+    node.resume();
+    EXPECT_EQ(node.updates(), newest.updates) << log.str();
+    EXPECT_EQ(static_cast<std::int64_t>(node.replay().size()), resumed_transitions);
+    EXPECT_GT(resumed_transitions, 0);
+  }
+
+  // An actor that hangs: no more episode reports; killed and restarted.
+  {
+    const double at = last_wall(run);
+    ASSERT_EQ(kill(pid_of("actor0"), SIGSTOP), 0);
+    EXPECT_TRUE(wait_for([&] { return launcher_says("actor0 silent for"); }, 25)) << train.log();
+    EXPECT_TRUE(wait_for([&] { return actor_stepped_after(run, "0", at + 1.0); }, 30))
+        << train.log();
+  }
+
+  train.signal(SIGINT);
+  const int status = train.wait_for_exit(std::chrono::seconds(90));
+  ASSERT_TRUE(WIFEXITED(status)) << train.log();
+  EXPECT_EQ(WEXITSTATUS(status), 130) << train.log();
+  EXPECT_FALSE(launcher_says("times within")) << "no role gave up: " << train.log();
+}
+
+}  // namespace
