@@ -463,6 +463,13 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         r->finished = true;
         continue;
       }
+      if (r->actor_id >= 0 && clean) {
+        // An actor ends by itself only when the learner's schedule has ended (training_done in
+        // the weights) or its own episode budget is spent: restarting it would only run
+        // episodes nobody learns from.
+        r->finished = true;
+        continue;
+      }
       while (!r->restarts.empty() && seconds_since(r->restarts.front()) > rc.run.restart_window_s) {
         r->restarts.pop_front();
       }
