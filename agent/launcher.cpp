@@ -139,6 +139,17 @@ QuickScore quick_evaluate(const sim::VehicleModel& model, const task::TaskConfig
   return s;
 }
 
+/// Whether dir holds a finished learner checkpoint (checkpoint-<updates>.ckpt). A learner
+/// killed while writing leaves only its temporary file, which --resume cannot use.
+bool has_checkpoint_file(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("checkpoint-", 0) == 0 && entry.path().extension() == ".ckpt") return true;
+  }
+  return false;
+}
+
 std::string format_duration(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   const long total = std::lround(s);
@@ -225,7 +236,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     }
     if (!last.empty()) trained_before_s = std::atof(last.c_str());
   }
-  const bool has_checkpoint = !fs::is_empty(run_dir / "checkpoints");
+  const bool has_checkpoint = has_checkpoint_file(run_dir / "checkpoints");
 
   transport::apply_transport_arguments(options.transport_args, rc.transport);
   // Every process opens the same transport as the launcher.
@@ -419,6 +430,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   int exit_code = 0;
   bool learner_done = false;
   double last_print_s = -1e9;
+  auto last_check = Clock::now();
   while (true) {
     transport->handle(100);
     if (signals::stop_requested()) {
@@ -430,6 +442,29 @@ int run_training(const TrainOptions& options, std::ostream& out) {
       stop_reason = "training budget of " + format_duration(rc.run.max_train_s) + " used";
       break;
     }
+    // The launcher's own pauses (a quick evaluation, starved of CPU by busier processes, a
+    // blocked write) are not the processes' silence: a gap between two passes here beyond 1 s
+    // moves every sign of life forward by it (measured: a nice 19 launcher on a machine
+    // loaded by other work stalled 80 s at a time and took every process for hung).
+    // And when nobody at all was heard for half the timeout, the machine (or the bus) is the
+    // likelier culprit than every process at once: nobody is killed for silence then.
+    bool anyone_heard = false;
+    {
+      const auto now = Clock::now();
+      if (now - last_check > std::chrono::seconds(1)) {
+        for (auto* alive : {&alive_by_pid, &alive_by_actor}) {
+          for (auto& entry : *alive)
+            entry.second = std::min(now, entry.second + (now - last_check));
+        }
+      }
+      last_check = now;
+      for (const auto* alive : {&alive_by_pid, &alive_by_actor}) {
+        for (const auto& entry : *alive) {
+          anyone_heard =
+              anyone_heard || seconds_since(entry.second) < rc.run.heartbeat_timeout_s / 2;
+        }
+      }
+    }
     // Supervision: restart what died, with back-off; give up on a role that keeps dying.
     for (auto& r : roles) {
       if (r->finished) continue;
@@ -437,7 +472,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         if (Clock::now() >= r->restart_due) {
           r->waiting_restart = false;
           out << (tty ? "\n" : "") << "auvrl train: restarting " << r->name << "\n";
-          start_role(*r, r.get() == learner && !fs::is_empty(run_dir / "checkpoints"));
+          start_role(*r, r.get() == learner && has_checkpoint_file(run_dir / "checkpoints"));
         }
         continue;
       }
@@ -446,7 +481,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         // below follows once it is reaped.
         auto& alive = r->actor_id >= 0 ? alive_by_actor : alive_by_pid;
         const auto seen = alive.find(r->actor_id >= 0 ? r->actor_id : r->proc->pid());
-        if (rc.run.heartbeat_timeout_s > 0 && seen != alive.end() &&
+        if (rc.run.heartbeat_timeout_s > 0 && anyone_heard && seen != alive.end() &&
             seconds_since(seen->second) > rc.run.heartbeat_timeout_s) {
           out << (tty ? "\n" : "") << "auvrl train: " << r->name << " silent for "
               << std::lround(seconds_since(seen->second))
@@ -505,10 +540,6 @@ int run_training(const TrainOptions& options, std::ostream& out) {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
           const QuickScore score = quick_evaluate(model, rc.task, net, rc.run.best_eval_suite);
-          // The launcher did not listen meanwhile: nobody counts as silent for that time.
-          for (auto* alive : {&alive_by_pid, &alive_by_actor}) {
-            for (auto& entry : *alive) entry.second = Clock::now();
-          }
           if (best_version < 0 || score.better_than(best)) {
             best = score;
             best_version = w->version;

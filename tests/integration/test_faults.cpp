@@ -78,8 +78,9 @@ bool wait_for(const std::function<bool()>& condition, double seconds) {
   return condition();
 }
 
-/// The fast preset with checkpoints every 2 s and a hang watch of 8 s; no quick evaluations.
-std::string faults_config(const std::string& dir) {
+/// The fast preset with checkpoints every `checkpoint_s` and a hang watch of 8 s; no quick
+/// evaluations.
+std::string faults_config(const std::string& dir, int checkpoint_s = 2) {
   std::ifstream in(kPreset);
   const std::string path = dir + "/fast_faults.yaml";
   std::ofstream out(path);
@@ -88,7 +89,7 @@ std::string faults_config(const std::string& dir) {
     if (line.rfind("vehicle:", 0) == 0) {
       line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
     } else if (line.find("checkpoint_period_s:") != std::string::npos) {
-      line = "  checkpoint_period_s: 2";
+      line = "  checkpoint_period_s: " + std::to_string(checkpoint_s);
     } else if (line.rfind("run:", 0) == 0) {
       line += "\n  heartbeat_timeout_s: 8\n  best_eval_period_s: 100000";
     }
@@ -243,6 +244,35 @@ TEST(LauncherFaults, KilledAndHungProcessesComeBackAndNothingIsLost) {
   ASSERT_TRUE(WIFEXITED(status)) << train.log();
   EXPECT_EQ(WEXITSTATUS(status), 130) << train.log();
   EXPECT_FALSE(launcher_says("times within")) << "no role gave up: " << train.log();
+}
+
+// A learner killed while it wrote its first checkpoint leaves only the temporary file: the
+// launcher must restart it afresh (not with --resume, which finds no checkpoint and fails).
+TEST(LauncherFaults, LearnerKilledBeforeItsFirstCheckpointStartsAfresh) {
+  const std::string tmp = test_support::make_temp_dir("auvrl_faults_first_");
+  const std::string dir = tmp + "/run";
+  const fs::path run(dir);
+  ChildProcess train(
+      {test_support::bin_path("auvrl"), "train", "--config", faults_config(tmp, 100000),
+       "--run-dir", dir, "--network", "host", "--actors", "1", "--max-seconds", "120", "--no-eval"},
+      dir + ".log");
+  ASSERT_TRUE(wait_for([&] { return read_csv(run / "episodes.csv").size() >= 5; }, 60))
+      << train.log();
+  // What a checkpoint write cut short by SIGKILL leaves behind.
+  std::ofstream(run / "checkpoints" / "checkpoint-000000000100.ckpt.tmp") << "partial";
+  ASSERT_EQ(kill(read_pid(run / "processes" / "learner.pid"), SIGKILL), 0);
+  ASSERT_TRUE(
+      wait_for([&] { return train.log().find("restarting learner") != std::string::npos; }, 15))
+      << train.log();
+  // The new learner runs: it reports again, and never fails for want of a checkpoint.
+  const std::size_t rows = read_csv(run / "learner.csv").size();
+  EXPECT_TRUE(wait_for([&] { return read_csv(run / "learner.csv").size() > rows + 3; }, 30))
+      << train.log();
+  const std::string learner_log = read_text(run / "processes" / "learner.log");
+  EXPECT_EQ(learner_log.find("no checkpoint-"), std::string::npos) << learner_log;
+  EXPECT_EQ(train.log().find("learner ended (exit"), std::string::npos) << train.log();
+  train.signal(SIGINT);
+  EXPECT_GE(train.wait_for_exit(std::chrono::seconds(90)), 0);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -120,12 +121,30 @@ TEST_P(LauncherSupervision, RestartsKilledProcessesStopsCleanlyAndResumes) {
       << train.log();
   EXPECT_NE(read_pid(run / "processes" / "actor0.pid"), actor);
 
-  // The learner killed after its first checkpoint comes back from that checkpoint.
-  ASSERT_TRUE(wait_for([&] { return !fs::is_empty(run / "checkpoints"); }, 20)) << train.log();
+  // The learner killed after its first checkpoint comes back from that checkpoint (a finished
+  // one: a learner killed while writing its first leaves only the temporary file and starts
+  // afresh, see test_faults).
+  const auto finished_checkpoint = [&] {
+    for (const auto& e : fs::directory_iterator(run / "checkpoints")) {
+      if (e.path().extension() == ".ckpt") return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(wait_for(finished_checkpoint, 20)) << train.log();
   ASSERT_EQ(kill(read_pid(run / "processes" / "learner.pid"), SIGKILL), 0);
   ASSERT_TRUE(wait_for([&] { return learner_log().find("resumed from") != std::string::npos; }, 20))
       << train.log() << learner_log();
   EXPECT_NE(train.log().find("learner ended (signal 9); restarting"), std::string::npos);
+  {
+    // It resumed a whole checkpoint: the update count restored is the one the file is named
+    // after (test_faults also checks the replay content against the file).
+    std::smatch m;
+    const std::string log = learner_log();
+    ASSERT_TRUE(std::regex_search(
+        log, m, std::regex("resumed from \\S+checkpoint-0*(\\d+)\\.ckpt \\((\\d+) updates")))
+        << log;
+    EXPECT_EQ(m[1].str(), m[2].str()) << log;
+  }
   // Training goes on after it: more episodes arrive.
   const std::size_t episodes_now = read_csv(run / "episodes.csv").size();
   EXPECT_TRUE(
@@ -144,7 +163,8 @@ TEST_P(LauncherSupervision, RestartsKilledProcessesStopsCleanlyAndResumes) {
   ASSERT_FALSE(learner_rows.empty());
   const long updates_before = std::atol(learner_rows.back().at("updates").c_str());
 
-  // --resume continues from the newest checkpoint.
+  // --resume continues from the newest checkpoint: wait for the learner to say so, then stop
+  // the run (a fixed short budget raced with the learner's start, slower over DDS).
   const auto count_resumes = [&] {
     std::size_t n = 0, pos = 0;
     const std::string log = learner_log();
@@ -153,10 +173,12 @@ TEST_P(LauncherSupervision, RestartsKilledProcessesStopsCleanlyAndResumes) {
   };
   const std::size_t resumes_before = count_resumes();
   ChildProcess resumed({test_support::bin_path("auvrl"), "train", "--resume", dir, "--network",
-                        "host", "--max-seconds", "0.001", "--no-eval", "--transport", GetParam()},
+                        "host", "--max-seconds", "120", "--no-eval", "--transport", GetParam()},
                        dir + "-resume.log");
+  EXPECT_TRUE(wait_for([&] { return count_resumes() == resumes_before + 1; }, 60))
+      << resumed.log() << learner_log();
+  resumed.signal(SIGINT);
   ASSERT_GE(resumed.wait_for_exit(std::chrono::seconds(60)), 0) << resumed.log();
-  EXPECT_EQ(count_resumes(), resumes_before + 1) << learner_log();
   EXPECT_GT(updates_before, 0);
   EXPECT_NE(train.log().find(GetParam() == "dds" ? "dds domain 0" : "udpm://"), std::string::npos)
       << "the run's transport";
