@@ -91,13 +91,21 @@ void read_transport_section(config::Section s, TransportConfig& config) {
   }
   s.read("allow_off_host", config.allow_off_host);
   s.finish();
+  // Name the key that widens the configuration: the URL for LCM, the DDS settings otherwise.
   try {
-    if (config.kind == TransportKind::kDds) check_dds_settings(config.dds, config.allow_off_host);
     if (config.kind == TransportKind::kLcm) {
       check_url_is_host_only(config.lcm_url, config.allow_off_host);
     }
   } catch (const TransportError& e) {
-    s.fail("kind", e.what());
+    s.fail("lcm_url", e.what());
+  }
+  try {
+    if (config.kind == TransportKind::kDds) check_dds_settings(config.dds, config.allow_off_host);
+  } catch (const TransportError& e) {
+    s.fail(s.has("dds_config")  ? "dds_config"
+           : s.has("dds_peers") ? "dds_peers"
+                                : "kind",
+           e.what());
   }
 }
 

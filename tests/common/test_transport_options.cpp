@@ -127,6 +127,13 @@ TEST_F(TransportSection, ErrorsNameTheKey) {
     FAIL() << "an off-host peer was accepted without allow_off_host";
   } catch (const config::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("allow-off-host"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dds_peers"), std::string::npos) << e.what();
+  }
+  try {
+    read("transport:\n  lcm_url: udpm://239.255.76.67:7667?ttl=1\n");
+    FAIL() << "an LCM URL with ttl=1 was accepted without allow_off_host";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("lcm_url"), std::string::npos) << e.what();
   }
   EXPECT_NO_THROW(read("transport:\n  kind: dds\n  dds_peers: 10.0.0.2\n  allow_off_host: true\n"));
 }
