@@ -426,6 +426,18 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                          std::chrono::duration<double>(rc.run.best_eval_period_s));
   QuickScore best;
   std::int64_t best_version = -1;
+  if (options.resume && fs::exists(run_dir / "policy_best.nn")) {
+    // A resumed run keeps its best policy unless a newer one scores better.
+    try {
+      const nn::Mlp previous =
+          nn::network_from_bytes(nn::read_file((run_dir / "policy_best.nn").string()), 1);
+      best = quick_evaluate(model, rc.task, previous, rc.run.best_eval_suite);
+      best_version = 0;
+    } catch (const std::exception& e) {
+      out << "auvrl train: " << (run_dir / "policy_best.nn").string()
+          << " not used as the best so far: " << e.what() << "\n";
+    }
+  }
   std::string stop_reason;
   int exit_code = 0;
   bool learner_done = false;
@@ -627,9 +639,11 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   out << "auvrl train: run directory " << run_dir.string() << "\n"
       << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
       << "  policy       " << (run_dir / "policy.nn").string()
-      << (best_version >= 0
-              ? "  (best so far: policy_best.nn, version " + std::to_string(best_version) + ")"
-              : "")
+      << (best_version >= 0 ? "  (best so far: policy_best.nn, " +
+                                  (best_version == 0 ? std::string("from before the resume")
+                                                     : "version " + std::to_string(best_version)) +
+                                  ")"
+                            : "")
       << "\n  logs         " << (run_dir / "logs").string() << "\n";
   if (exit_code != 0) {
     out << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
