@@ -553,11 +553,11 @@ void check_dds_settings(const DdsSettings& s, bool allow_off_host) {
 std::string dds_default_config_xml(const DdsSettings& s) {
   bool all_loopback = true;
   for (const std::string& peer : s.peers) all_loopback = all_loopback && is_loopback_peer(peer);
-  std::string xml = "<CycloneDDS><Domain id=\"any\"><General>";
+  std::string xml = R"(<CycloneDDS><Domain id="any"><General>)";
   // Off-host peers: Cyclone picks the interface that reaches them.
-  if (all_loopback) xml += "<Interfaces><NetworkInterface name=\"lo\"/></Interfaces>";
+  if (all_loopback) xml += R"(<Interfaces><NetworkInterface name="lo"/></Interfaces>)";
   xml += "<AllowMulticast>false</AllowMulticast></General><Discovery><Peers>";
-  for (const std::string& peer : s.peers) xml += "<Peer address=\"" + peer + "\"/>";
+  for (const std::string& peer : s.peers) xml += R"(<Peer address=")" + peer + R"("/>)";
   xml += "</Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
          std::to_string(s.max_auto_participant_index) +
          "</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";

@@ -22,61 +22,20 @@
 #include "learner/learner_config.hpp"
 #include "learner/learner_node.hpp"
 #include "logger/event_log.hpp"
+#include "run_files.hpp"
 
 namespace {
 
 using namespace auvrl;
 namespace fs = std::filesystem;
 using test_support::ChildProcess;
+using test_support::read_csv;
+using test_support::read_pid;
+using test_support::read_text;
+using test_support::wait_for;
 
 const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
 constexpr int kEndSimTimeout = 5;  // episode_report_t::END_SIM_TIMEOUT
-
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  const auto split = [](const std::string& text) {
-    std::vector<std::string> cells;
-    std::stringstream ss(text);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    return cells;
-  };
-  if (std::getline(in, line)) header = split(line);
-  while (std::getline(in, line)) {
-    const auto cells = split(line);
-    if (cells.size() != header.size()) continue;  // a row being written
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = cells[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-int read_pid(const fs::path& path) {
-  std::ifstream in(path);
-  int pid = -1;
-  in >> pid;
-  return pid;
-}
-
-bool wait_for(const std::function<bool()>& condition, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return condition();
-}
 
 /// The fast preset with checkpoints every `checkpoint_s` and a hang watch of 8 s; no quick
 /// evaluations.

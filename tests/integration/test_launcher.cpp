@@ -15,6 +15,7 @@
 #include "child_process.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
+#include "run_files.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace {
@@ -22,47 +23,11 @@ namespace {
 using namespace auvrl;
 namespace fs = std::filesystem;
 using test_support::ChildProcess;
+using test_support::read_csv;
+using test_support::read_pid;
+using test_support::wait_for;
 
 const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-
-/// Rows of a CSV file as maps from column to text.
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  const auto split = [](const std::string& text) {
-    std::vector<std::string> cells;
-    std::stringstream ss(text);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    return cells;
-  };
-  if (std::getline(in, line)) header = split(line);
-  while (std::getline(in, line)) {
-    const auto cells = split(line);
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-int read_pid(const fs::path& path) {
-  std::ifstream in(path);
-  int pid = -1;
-  in >> pid;
-  return pid;
-}
-
-bool wait_for(const std::function<bool()>& condition, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
-    if (condition()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return condition();
-}
 
 /// The fast preset with checkpoints every 2 s (so a killed learner has one to resume from).
 std::string quick_checkpoint_config(const std::string& dir) {

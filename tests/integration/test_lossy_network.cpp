@@ -14,35 +14,14 @@
 #include <thread>
 
 #include "child_process.hpp"
+#include "run_files.hpp"
 
 namespace {
 
 using namespace auvrl;
 namespace fs = std::filesystem;
 using test_support::ChildProcess;
-
-std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> header;
-  std::vector<std::map<std::string, std::string>> rows;
-  const auto split = [](const std::string& text) {
-    std::vector<std::string> cells;
-    std::stringstream ss(text);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    return cells;
-  };
-  if (std::getline(in, line)) header = split(line);
-  while (std::getline(in, line)) {
-    const auto cells = split(line);
-    if (cells.size() != header.size()) continue;
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = cells[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
+using test_support::read_csv;
 
 /// Runs a command, returns its exit status (its output in the log).
 int run(const std::vector<std::string>& argv, const std::string& log) {
