@@ -11,8 +11,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # LCM tools, Java bindings for lcm-spy, DDS tools
   liblcm-bin liblcm-java libjchart2d-java default-jdk-headless cyclonedds-tools
-  # network namespaces (unshare, nsenter, ip), packet loss inside them (nft), process tools
-  util-linux iproute2 nftables procps
+  # network namespaces (unshare, nsenter, ip), packet loss inside them (nft), process tools;
+  # delay and jitter inside them where the kernel has no netem (auv_netdelay: NFQUEUE)
+  util-linux iproute2 nftables procps iptables libnetfilter-queue-dev
   # plots
   python3 python3-matplotlib python3-numpy
 )
