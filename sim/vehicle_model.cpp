@@ -80,7 +80,9 @@ class FileReader {
     if (!node.IsMap()) fail(field, "expected a map of keys", &node);
     std::set<std::string> known(allowed.begin(), allowed.end());
     for (const auto& entry : node) {
-      const std::string key = entry.first.as<std::string>();
+      // A complex key ("? [a, b]: ...") is valid YAML but no name (found by fuzz_vehicle_yaml).
+      if (!entry.first.IsScalar()) fail(field, "expected names as keys", &entry.first);
+      const std::string key = entry.first.Scalar();
       if (known.count(key) == 0) {
         std::string list;
         for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);

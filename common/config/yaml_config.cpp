@@ -171,7 +171,13 @@ void Section::ignore(std::initializer_list<const char*> keys) {
 void Section::finish() const {
   if (!node_.IsMap()) return;
   for (const auto& entry : node_) {
-    const std::string key = entry.first.as<std::string>();
+    // A complex key ("? [a, b]: ...") is valid YAML but no name (found by fuzz_run_config).
+    if (!entry.first.IsScalar()) {
+      throw ConfigError(file_ + ": '" + (path_.empty() ? std::string("top level") : path_) +
+                        "': expected names as keys (line " +
+                        std::to_string(entry.first.Mark().line + 1) + ")");
+    }
+    const std::string key = entry.first.Scalar();
     if (read_.count(key) == 0) {
       std::string known;
       for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;

@@ -118,6 +118,16 @@ TEST_F(TransportSection, DdsWithDomainAndPeers) {
   EXPECT_EQ(c.dds.peers, (std::vector<std::string>{"127.0.0.1", "127.0.0.2"}));
 }
 
+// Found by fuzz_run_config: a complex key ended the process (uncaught yaml-cpp error).
+TEST_F(TransportSection, AComplexKeyIsAnErrorNotACrash) {
+  try {
+    read("? [a, b]\n: 1\nrun:\n  actors: 1\n");
+    FAIL() << "a complex key was accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected names as keys"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(TransportSection, ErrorsNameTheKey) {
   EXPECT_THROW(read("transport:\n  kind: zmq\n"), config::ConfigError);
   EXPECT_THROW(read("transport:\n  knid: dds\n"), config::ConfigError);

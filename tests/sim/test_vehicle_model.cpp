@@ -160,6 +160,9 @@ INSTANTIATE_TEST_SUITE_P(
                    "rigid_body.mas_kg"},
         Corruption{"unknown top-level key", "name: nessie7\n", "name: nessie7\ncolour: yellow\n",
                    "colour"},
+        // Found by fuzz_vehicle_yaml: a complex key ended the process (uncaught yaml-cpp error).
+        Corruption{"complex key", "  mass_kg: 60.0\n", "  mass_kg: 60.0\n  ? [a, b]\n  : 1\n",
+                   "rigid_body"},
         Corruption{"bad integrator", "integrator: rk4", "integrator: rk5",
                    "integration.integrator"},
         Corruption{"substeps < 1", "substeps: 10", "substeps: 0", "integration.substeps"},
