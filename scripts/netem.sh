@@ -17,6 +17,10 @@
 # (uniform, clamped at 0) in user space, so a round trip on lo takes two such delays; else an
 # nftables rule that drops the loss share on input, without delay or jitter (it says so).
 # Root or user namespaces, as scripts/netns.sh.
+# Measured (README, Reliability; 2-core VM, load ~3.5): at 10% loss + 5ms +- 5ms, fast preset,
+# 1 actor, 60 s: clean ~12k env steps/s; impaired 56 with --lockstep-timeout-ms 30, 17 with the
+# default 200 (neither reached the warm-up); 300 s with 8 actors and 30 ms: 460 steps/s, 23 %
+# success at the end.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${AUVRL_BIN_DIR:-$root/build/bin}
@@ -34,7 +38,7 @@ while [ $# -gt 0 ]; do
     --seed) seed=$2; shift 2 ;;
     --lockstep-timeout-ms) timeout_ms=$2; shift 2 ;;
     --) shift; extra=("$@"); break ;;
-    *) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
+    *) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 2 ;;
   esac
 done
 command -v tc >/dev/null || { echo "netem: tc is missing (apt-get install iproute2)" >&2; exit 1; }
