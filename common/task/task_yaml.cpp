@@ -1,5 +1,7 @@
 #include "common/task/task_yaml.hpp"
 
+#include <cmath>
+
 namespace auvrl::task {
 
 void read_task_config(config::Section s, TaskConfig& c) {
@@ -62,6 +64,11 @@ GoalSchedule read_goal_schedule(config::Section s, const GoalSchedule& fallback)
   std::vector<ScheduleKnot> parsed;
   for (const auto& row : knots) {
     if (row.size() != 2) s.fail("knots", "each knot is [episode, beta_m]");
+    // Checked before the conversion: a double beyond int64's range does not convert (found by
+    // fuzz_run_config).
+    if (!(row[0] >= 0 && row[0] <= 1e15 && row[0] == std::floor(row[0]))) {
+      s.fail("knots", "a knot's episode must be a whole number from 0 to 1e15");
+    }
     parsed.push_back({static_cast<std::int64_t>(row[0]), row[1]});
   }
   try {

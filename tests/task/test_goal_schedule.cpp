@@ -1,11 +1,16 @@
 // The goal-radius schedule: the paper's knots, the interpolations between them, validation.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <stdexcept>
 
+#include "common/config/yaml_config.hpp"
 #include "common/task/goal_schedule.hpp"
+#include "common/task/task_yaml.hpp"
 
 namespace auvrl::task {
 namespace {
@@ -88,6 +93,29 @@ TEST(GoalSchedule, InterpolationNames) {
     EXPECT_EQ(parse_interpolation(to_string(i)), i);
   }
   EXPECT_THROW(parse_interpolation("exponential"), std::invalid_argument);
+}
+
+// Found by fuzz_run_config: an episode beyond int64's range was converted (undefined).
+TEST(GoalScheduleFile, KnotEpisodesMustBeWholeNumbersInRange) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("auvrl_schedule_" + std::to_string(getpid()) + ".yaml"))
+                               .string();
+  const auto read = [&](const std::string& knots) {
+    std::ofstream(path) << "schedule:\n  knots: " << knots << "\n";
+    config::Section root = config::load_file(path);
+    return read_goal_schedule(root.child("schedule"), GoalSchedule());
+  };
+  EXPECT_DOUBLE_EQ(read("[[0, 1.5], [3000, 0.5]]").beta_m(3000), 0.5);
+  for (const char* bad :
+       {"[[0, 1.5], [7.8e28, 0.5]]", "[[-1, 1.5]]", "[[0, 1.5], [2.5, 0.5]]", "[[.nan, 1.5]]"}) {
+    try {
+      read(bad);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("knots"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace
