@@ -8,6 +8,7 @@
 
 #include "learner/ddpg.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <utility>
 
@@ -259,8 +260,16 @@ void Ddpg::restore(nn::Reader& r) {
   auto net = [&](nn::Mlp& m, const char* name) {
     const std::uint64_t size = r.u64();
     if (size > (std::uint64_t{1} << 32)) r.fail(std::string(name) + ": implausible size");
-    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-    r.bytes(bytes.data(), bytes.size());
+    // Grown as the bytes arrive, so a damaged size field costs at most what the file holds
+    // (allocating it up front took ~4 GB for a short file; found by fuzz_checkpoint).
+    std::vector<std::uint8_t> bytes;
+    constexpr std::uint64_t kChunk = 1 << 16;
+    while (bytes.size() < size) {
+      const std::size_t have = bytes.size();
+      const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kChunk, size - have));
+      bytes.resize(have + n);
+      r.bytes(bytes.data() + have, n);
+    }
     try {
       nn::load_network(m, bytes);
     } catch (const std::runtime_error& e) {
