@@ -23,6 +23,7 @@
 #include "learner/checkpoint.hpp"
 #include "learner/learner_config.hpp"
 #include "learner/learner_node.hpp"
+#include "run_files.hpp"
 
 namespace {
 
@@ -135,20 +136,12 @@ TEST(LauncherDiskFull, RunStopsNamingThePathAndTheNewestCheckpointRestores) {
   if (disk.empty()) GTEST_SKIP() << "no private tmpfs: " << why;
   const std::string tmp = test_support::make_temp_dir("auvrl_disk_full_");
   // The fast preset with checkpoints every 2 s.
-  const std::string config = tmp + "/fast.yaml";
-  {
-    std::ifstream in(kPreset);
-    std::ofstream out(config);
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.rfind("vehicle:", 0) == 0) {
-        line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
-      } else if (line.find("checkpoint_period_s:") != std::string::npos) {
-        line = "  checkpoint_period_s: 2";
-      }
-      out << line << "\n";
-    }
-  }
+  const std::string config = test_support::write_preset_copy(
+      AUVRL_CONFIG_DIR, "fast", tmp + "/fast.yaml", [](std::string& line) {
+        if (line.find("checkpoint_period_s:") != std::string::npos) {
+          line = "  checkpoint_period_s: 2";
+        }
+      });
   const std::string run = disk + "/run";
   ChildProcess train(
       {test_support::bin_path("auvrl"), "train", "--config", config, "--run-dir", run, "--network",

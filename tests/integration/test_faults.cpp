@@ -34,27 +34,19 @@ using test_support::read_pid;
 using test_support::read_text;
 using test_support::wait_for;
 
-const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
 constexpr int kEndSimTimeout = 5;  // episode_report_t::END_SIM_TIMEOUT
 
 /// The fast preset with checkpoints every `checkpoint_s` and a hang watch of 8 s; no quick
 /// evaluations.
 std::string faults_config(const std::string& dir, int checkpoint_s = 2) {
-  std::ifstream in(kPreset);
-  const std::string path = dir + "/fast_faults.yaml";
-  std::ofstream out(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("vehicle:", 0) == 0) {
-      line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
-    } else if (line.find("checkpoint_period_s:") != std::string::npos) {
-      line = "  checkpoint_period_s: " + std::to_string(checkpoint_s);
-    } else if (line.rfind("run:", 0) == 0) {
-      line += "\n  heartbeat_timeout_s: 8\n  best_eval_period_s: 100000";
-    }
-    out << line << "\n";
-  }
-  return path;
+  return test_support::write_preset_copy(
+      AUVRL_CONFIG_DIR, "fast", dir + "/fast_faults.yaml", [checkpoint_s](std::string& line) {
+        if (line.find("checkpoint_period_s:") != std::string::npos) {
+          line = "  checkpoint_period_s: " + std::to_string(checkpoint_s);
+        } else if (line.rfind("run:", 0) == 0) {
+          line += "\n  heartbeat_timeout_s: 8\n  best_eval_period_s: 100000";
+        }
+      });
 }
 
 /// Whether actor `id` finished an episode that really stepped (not ended by a lockstep

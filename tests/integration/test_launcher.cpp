@@ -31,19 +31,12 @@ const std::string kPreset = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml"
 
 /// The fast preset with checkpoints every 2 s (so a killed learner has one to resume from).
 std::string quick_checkpoint_config(const std::string& dir) {
-  std::ifstream in(kPreset);
-  const std::string path = dir + "/fast_quick_checkpoints.yaml";
-  std::ofstream out(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.rfind("vehicle:", 0) == 0) {
-      line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
-    } else if (line.find("checkpoint_period_s:") != std::string::npos) {
-      line = "  checkpoint_period_s: 2";
-    }
-    out << line << "\n";
-  }
-  return path;
+  return test_support::write_preset_copy(
+      AUVRL_CONFIG_DIR, "fast", dir + "/fast_quick_checkpoints.yaml", [](std::string& line) {
+        if (line.find("checkpoint_period_s:") != std::string::npos) {
+          line = "  checkpoint_period_s: 2";
+        }
+      });
 }
 
 /// The supervision test runs once per transport (lcm, dds): auvrl train --transport NAME.

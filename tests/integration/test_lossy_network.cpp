@@ -96,22 +96,14 @@ TEST(LossyNetwork, TrainingGoesOnWithTenPercentDatagramLoss) {
   // The fast preset with the lockstep timeout for a lossy link: each lost command or state
   // costs one timeout (10 ms instead of the default 200 ms; 30 ms above the delayed round
   // trip). With the delay a step takes ~15 ms: 100-step episodes, so that several end in 30 s.
-  const std::string config = tmp + "/fast_lossy.yaml";
-  {
-    std::ifstream in(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
-    std::ofstream out(config);
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.rfind("vehicle:", 0) == 0) {
-        line = "vehicle: " + std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
-      } else if (line.rfind("actor:", 0) == 0) {
-        line += delayed ? "\n  lockstep_timeout_ms: 30" : "\n  lockstep_timeout_ms: 10";
-      } else if (delayed && line.rfind("  max_steps:", 0) == 0) {
-        line = "  max_steps: 100";
-      }
-      out << line << "\n";
-    }
-  }
+  const std::string config = test_support::write_preset_copy(
+      AUVRL_CONFIG_DIR, "fast", tmp + "/fast_lossy.yaml", [delayed](std::string& line) {
+        if (line.rfind("actor:", 0) == 0) {
+          line += delayed ? "\n  lockstep_timeout_ms: 30" : "\n  lockstep_timeout_ms: 10";
+        } else if (delayed && line.rfind("  max_steps:", 0) == 0) {
+          line = "  max_steps: 100";
+        }
+      });
   const std::string dir = tmp + "/run";
   ChildProcess train(
       {test_support::bin_path("auvrl"), "train", "--config", config, "--run-dir", dir, "--network",

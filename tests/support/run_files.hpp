@@ -65,4 +65,21 @@ inline bool wait_for(const std::function<bool()>& condition, double seconds) {
   return condition();
 }
 
+/// Writes a copy of config_dir/presets/<preset>.yaml to out_path for a test run: the vehicle
+/// path made absolute, then `edit` applied to every line (it may append lines with "\n").
+/// Returns out_path.
+inline std::string write_preset_copy(const std::string& config_dir, const std::string& preset,
+                                     const std::string& out_path,
+                                     const std::function<void(std::string& line)>& edit) {
+  std::ifstream in(config_dir + "/presets/" + preset + ".yaml");
+  std::ofstream out(out_path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) == 0) line = "vehicle: " + config_dir + "/vehicles/nessie7.yaml";
+    edit(line);
+    out << line << "\n";
+  }
+  return out_path;
+}
+
 }  // namespace auvrl::test_support
