@@ -93,32 +93,11 @@ class Qos {
 
 dds_duration_t to_dds(std::chrono::milliseconds ms) { return DDS_MSECS(ms.count()); }
 
-void set_writer_qos(const Qos& q, ChannelClass c, bool lockstep_reliable) {
-  switch (c) {
-    case ChannelClass::kState:
-      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, 1);
-      dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
-      break;
-    case ChannelClass::kQueue:
-      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDdsQueueMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_ALL, 0);
-      break;
-    case ChannelClass::kLockstep:
-      dds_qset_reliability(
-          q.get(), lockstep_reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
-          to_dds(kDefaultMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, kLockstepWriterDepth);
-      break;
-    case ChannelClass::kOther:
-      dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, kOtherWriterDepth);
-      break;
-  }
-}
-
-void set_reader_qos(const Qos& q, ChannelClass c, bool lockstep_reliable, int queue_capacity) {
-  const int depth = std::max(1, queue_capacity);
+/// The QoS of a class's writers (reader_capacity < 0) or of a subscription's readers (its queue
+/// capacity): the same reliability, history kind and durability on both sides, so they match.
+void set_qos(const Qos& q, ChannelClass c, bool lockstep_reliable, int reader_capacity) {
+  const bool reader = reader_capacity >= 0;
+  const int depth = std::max(1, reader_capacity);
   switch (c) {
     case ChannelClass::kState:
       // Only the newest per channel: a reader that falls behind skips versions.
@@ -127,21 +106,23 @@ void set_reader_qos(const Qos& q, ChannelClass c, bool lockstep_reliable, int qu
       dds_qset_durability(q.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
       break;
     case ChannelClass::kQueue:
-      // A full history rejects new samples; the reliable protocol then holds them at the
-      // writer, which waits: back-pressure, not loss.
+      // A reader's full history rejects new samples; the reliable protocol then holds them at
+      // the writer, which waits: back-pressure, not loss.
       dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDdsQueueMaxBlocking));
       dds_qset_history(q.get(), DDS_HISTORY_KEEP_ALL, 0);
-      dds_qset_resource_limits(q.get(), depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+      if (reader) {
+        dds_qset_resource_limits(q.get(), depth, DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
+      }
       break;
     case ChannelClass::kLockstep:
       dds_qset_reliability(
           q.get(), lockstep_reliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
           to_dds(kDefaultMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, reader ? depth : kLockstepWriterDepth);
       break;
     case ChannelClass::kOther:
       dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, to_dds(kDefaultMaxBlocking));
-      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
+      dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, reader ? depth : kOtherWriterDepth);
       break;
   }
 }
@@ -166,7 +147,7 @@ class DdsTransport final : public Transport {
       for (ChannelClass c : kAllClasses) {
         const dds_entity_t topic = create_topic(c);
         Qos qos;
-        set_writer_qos(qos, c, lockstep_reliable_);
+        set_qos(qos, c, lockstep_reliable_, -1);
         writers_[index(c)] =
             check(dds_create_writer(participant_, topic, qos.get(), nullptr), "create a writer");
       }
@@ -236,7 +217,7 @@ class DdsTransport final : public Transport {
         check(dds_set_topic_filter_and_arg(topic, &Subscription::accept, sub.get()),
               "set a topic filter");
         Qos qos;
-        set_reader_qos(qos, c, lockstep_reliable_, queue_capacity);
+        set_qos(qos, c, lockstep_reliable_, std::max(1, queue_capacity));
         const dds_entity_t reader =
             check(dds_create_reader(participant_, topic, qos.get(), nullptr), "create a reader");
         sub->entities.push_back(reader);
