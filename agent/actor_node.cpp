@@ -44,6 +44,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
              config_.seed * 0x9E3779B97F4A7C15ull + 1),
       goal_rng_(config_.seed),
+      start_rng_(config_.seed * 0xBF58476D1CE4E5B9ull + 7),
       policy_(config_.task.state_dim(), config_.task.num_thrusters, config_.initial_beta_m) {
   config_.task.validate();
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
@@ -109,8 +110,11 @@ EpisodeSummary ActorNode::run_one_episode() {
   EpisodeOptions options;
   options.goal_ned_m = task::sample_goal(config_.task, goal_rng_);
   options.beta_m = policy_.beta_m();
-  options.start.position_ned_m = config_.task.start_position_ned_m;
-  options.start.euler_rpy_rad = {0.0, 0.0, config_.task.start_yaw_rad};
+  const task::StartState start = task::sample_start(config_.task, start_rng_);
+  options.start.position_ned_m = start.position_ned_m;
+  options.start.euler_rpy_rad = start.euler_rpy_rad;
+  options.start.velocity_body_mps = start.velocity_body_mps;
+  options.start.angular_rate_body_rad_s = start.angular_rate_body_rad_s;
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
   options.noise = &noise_;
   std::vector<Transition> transitions;

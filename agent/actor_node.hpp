@@ -93,6 +93,7 @@ class ActorNode {
   std::unique_ptr<ExploringController> controller_;
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
+  std::mt19937_64 start_rng_;  ///< its own stream: exploring starts leave the goals unchanged
   ActorCounters counters_;
   /// Waits (flow control) while the learner's backlog is above the configured limit.
   void wait_for_learner();

@@ -206,6 +206,7 @@ std::string prepare_run_directory(TrainOptions& o) {
         << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
         << "  checkpoints/      learner checkpoints (auvrl train --resume " << o.run_dir << ")\n"
         << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
+        << "  quick_eval.csv    every quick evaluation (reached, mean time, hold error, kept)\n"
         << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"
         << "  processes/        each process's output\n"
         << "Watch the running system with lcm-spy: scripts/spy.sh " << o.run_dir << "\n";
@@ -256,6 +257,12 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   std::ofstream episodes_csv(run_dir / "episodes.csv", std::ios::app);
   std::ofstream learner_csv(run_dir / "learner.csv", std::ios::app);
   std::ofstream progress_csv(run_dir / "progress.csv", std::ios::app);
+  const bool new_quick_eval = !fs::exists(run_dir / "quick_eval.csv");
+  std::ofstream quick_eval_csv(run_dir / "quick_eval.csv", std::ios::app);
+  if (new_quick_eval) {
+    quick_eval_csv << "wall_s,policy_version,reached,episodes,mean_time_to_reach_s,"
+                      "mean_error_after_reach_m,kept\n";
+  }
   if (new_files) {
     episodes_csv << "wall_s,actor_id,episode_id,policy_version,return,length_steps,success,"
                     "final_distance_m,min_distance_m,beta_m,end_reason,thrust_energy\n";
@@ -552,11 +559,18 @@ int run_training(const TrainOptions& options, std::ostream& out) {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
           const QuickScore score = quick_evaluate(model, rc.task, net, rc.run.best_eval_suite);
-          if (best_version < 0 || score.better_than(best)) {
+          const bool keep = best_version < 0 || score.better_than(best);
+          if (keep) {
             best = score;
             best_version = w->version;
             nn::save_network_file((run_dir / "policy_best.nn").string(), net);
           }
+          quick_eval_csv << std::fixed << std::setprecision(1) << wall() << ',' << w->version << ','
+                         << score.reached << ',' << score.episodes << ',' << std::setprecision(2)
+                         << (score.reached > 0 ? score.mean_time_s : 0.0) << ','
+                         << std::setprecision(3) << (score.reached > 0 ? score.mean_hold_m : 0.0)
+                         << ',' << (keep ? 1 : 0) << '\n';
+          quick_eval_csv.flush();
         } catch (const std::exception& e) {
           out << "auvrl train: quick evaluation failed: " << e.what() << "\n";
         }
@@ -592,10 +606,11 @@ int run_training(const TrainOptions& options, std::ostream& out) {
       learner_csv.flush();
       // Disk full or run directory not writable: stop with the path named; the checkpoints
       // already written stay intact (the learner writes each to a new file and renames it).
-      if (!progress_csv || !episodes_csv || !learner_csv) {
+      if (!progress_csv || !episodes_csv || !learner_csv || !quick_eval_csv) {
         const char* file = !progress_csv   ? "progress.csv"
                            : !episodes_csv ? "episodes.csv"
-                                           : "learner.csv";
+                           : !learner_csv  ? "learner.csv"
+                                           : "quick_eval.csv";
         stop_reason = "cannot write " + (run_dir / file).string() + " (" +
                       (errno != 0 ? std::strerror(errno) : "write error") +
                       "): disk full or run directory not writable; the last checkpoint in " +

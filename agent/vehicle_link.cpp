@@ -14,6 +14,7 @@ class InProcessLink final : public VehicleLink {
   std::optional<VehicleReport> reset(const EpisodeStart& start) override {
     sim::ResetSettings settings;
     settings.eta << start.position_ned_m, start.euler_rpy_rad;
+    settings.nu << start.velocity_body_mps, start.angular_rate_body_rad_s;
     settings.thruster_efficiency =
         start.thruster_efficiency.empty()
             ? sim::ThrusterVector::Ones(model_.num_thrusters())
@@ -66,6 +67,8 @@ class LockstepLink final : public VehicleLink {
     for (int i = 0; i < 3; ++i) {
       msg.position_ned_m[i] = start.position_ned_m[i];
       msg.euler_rpy_rad[i] = start.euler_rpy_rad[i];
+      msg.velocity_body_mps[i] = start.velocity_body_mps[i];
+      msg.angular_rate_body_rad_s[i] = start.angular_rate_body_rad_s[i];
       msg.current_constant_ned_mps[i] = start.current_ned_mps[i];
     }
     msg.num_thrusters = static_cast<std::int8_t>(start.thruster_efficiency.size());

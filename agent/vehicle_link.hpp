@@ -27,6 +27,8 @@ struct VehicleReport {
 struct EpisodeStart {
   Eigen::Vector3d position_ned_m{0.0, 0.0, 5.0};
   Eigen::Vector3d euler_rpy_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_body_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_rate_body_rad_s = Eigen::Vector3d::Zero();
   std::vector<double> thruster_efficiency;  ///< empty: all healthy
   Eigen::Vector3d current_ned_mps = Eigen::Vector3d::Zero();
   std::uint64_t seed = 1;

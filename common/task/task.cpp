@@ -6,6 +6,7 @@
 namespace auvrl::task {
 
 namespace {
+constexpr double kPi = 3.14159265358979323846;
 constexpr int kPaperFixed = 3 + 3 + 6;             // x_pos, x_e, v
 constexpr int kExtendedFixed = 3 + 1 + 6 + 6 + 1;  // e_body, d, sin/cos, v, depth
 // Offsets of the extended layout.
@@ -70,6 +71,24 @@ void TaskConfig::validate() const {
                    hold_reward_per_step, distance_weight, precision_reward, start_yaw_rad}) {
     if (!std::isfinite(v)) throw std::invalid_argument("task: a reward constant is not finite");
   }
+  if (!(random_start_fraction >= 0 && random_start_fraction <= 1)) {
+    throw std::invalid_argument("task.random_start_fraction must be in [0, 1]");
+  }
+  const auto spread = [](const Eigen::Vector3d& v, double limit, const char* name) {
+    if (!v.allFinite() || v.minCoeff() < 0 || v.maxCoeff() > limit) {
+      throw std::invalid_argument(std::string("task.") + name + " must be 3 values in [0, " +
+                                  std::to_string(limit) + "]");
+    }
+  };
+  // Roll and pitch stay inside the flip angle (checked at the first step); the limits keep
+  // the starts within what the vehicle can do (about 1.6 m/s and 0.6 rad/s at full thrust).
+  spread(start_attitude_spread_rad, kPi, "start_attitude_spread_rad");
+  if (std::max(start_attitude_spread_rad[0], start_attitude_spread_rad[1]) >= flip_angle_rad) {
+    throw std::invalid_argument(
+        "task.start_attitude_spread_rad: roll and pitch spreads must be below flip_angle_rad");
+  }
+  spread(start_velocity_max_body_mps, 5.0, "start_velocity_max_body_mps");
+  spread(start_rate_max_body_rad_s, 2.0, "start_rate_max_body_rad_s");
   if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
       !goal_max_ned_m.allFinite() || (goal_max_ned_m - goal_min_ned_m).minCoeff() < 0) {
     throw std::invalid_argument("task: goal region must be finite with min <= max");
@@ -210,14 +229,41 @@ StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, 
   return out;
 }
 
+namespace {
+/// Uniform in [0, 1), portable (std::uniform_real_distribution differs between libraries).
+double unit_draw(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+/// Uniform in centre +- half_width, per component.
+Eigen::Vector3d spread_draw(const Eigen::Vector3d& centre, const Eigen::Vector3d& half_width,
+                            std::mt19937_64& rng) {
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) v[i] = centre[i] + (2.0 * unit_draw(rng) - 1.0) * half_width[i];
+  return v;
+}
+}  // namespace
+
 Eigen::Vector3d sample_goal(const TaskConfig& c, std::mt19937_64& rng) {
   Eigen::Vector3d g;
   for (int i = 0; i < 3; ++i) {
-    // Portable draw (std::uniform_real_distribution differs between libraries).
-    const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-    g[i] = c.goal_min_ned_m[i] + u * (c.goal_max_ned_m[i] - c.goal_min_ned_m[i]);
+    g[i] = c.goal_min_ned_m[i] + unit_draw(rng) * (c.goal_max_ned_m[i] - c.goal_min_ned_m[i]);
   }
   return g;
+}
+
+StartState sample_start(const TaskConfig& c, std::mt19937_64& rng) {
+  StartState rest;
+  rest.position_ned_m = c.start_position_ned_m;
+  rest.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, c.start_yaw_rad);
+  const bool random = unit_draw(rng) < c.random_start_fraction;
+  StartState drawn = rest;
+  drawn.euler_rpy_rad = spread_draw(rest.euler_rpy_rad, c.start_attitude_spread_rad, rng);
+  // Yaw wraps to (-pi, pi], the range the vehicle reports.
+  drawn.euler_rpy_rad[2] = std::remainder(drawn.euler_rpy_rad[2], 2.0 * kPi);
+  drawn.velocity_body_mps =
+      spread_draw(Eigen::Vector3d::Zero(), c.start_velocity_max_body_mps, rng);
+  drawn.angular_rate_body_rad_s =
+      spread_draw(Eigen::Vector3d::Zero(), c.start_rate_max_body_rad_s, rng);
+  return random ? drawn : rest;
 }
 
 }  // namespace auvrl::task

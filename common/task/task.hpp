@@ -96,6 +96,17 @@ struct TaskConfig {
   Eigen::Vector3d goal_min_ned_m{-10.0, -10.0, 1.0};
   Eigen::Vector3d goal_max_ned_m{10.0, 10.0, 15.0};
 
+  /// Exploring starts (training only: the evaluation always starts at rest at the start
+  /// pose). This share of training episodes starts in a random state: attitude uniform in
+  /// start attitude +- start_attitude_spread_rad, body velocities uniform in
+  /// +-start_velocity_max_body_mps and +-start_rate_max_body_rad_s. A policy that only ever
+  /// starts at rest never tries a second way of getting somewhere (measured: every policy
+  /// turned round and reversed to the way-point, even one straight ahead).
+  double random_start_fraction = 0.0;
+  Eigen::Vector3d start_attitude_spread_rad = Eigen::Vector3d::Zero();    ///< roll, pitch, yaw
+  Eigen::Vector3d start_velocity_max_body_mps = Eigen::Vector3d::Zero();  ///< u, v, w
+  Eigen::Vector3d start_rate_max_body_rad_s = Eigen::Vector3d::Zero();    ///< p, q, r
+
   /// Size of the observation vector.
   int state_dim() const;
   /// Throws std::invalid_argument naming the first unusable value.
@@ -167,5 +178,18 @@ StepOutcome evaluate_step(const TaskConfig& config, double distance_before_m,
 
 /// Draws a way-point uniformly in the configured box.
 Eigen::Vector3d sample_goal(const TaskConfig& config, std::mt19937_64& rng);
+
+/// Where and how a training episode starts (NED pose, body velocities).
+struct StartState {
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d euler_rpy_rad = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_body_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_rate_body_rad_s = Eigen::Vector3d::Zero();
+};
+
+/// The start of a training episode: at rest at the start pose, or, with probability
+/// random_start_fraction, a random state around it (see TaskConfig). Takes the same number of
+/// draws from rng either way.
+StartState sample_start(const TaskConfig& config, std::mt19937_64& rng);
 
 }  // namespace auvrl::task

@@ -44,6 +44,10 @@ void read_task_config(config::Section s, TaskConfig& c) {
   s.read("start_yaw_rad", c.start_yaw_rad);
   s.read("goal_min_ned_m", c.goal_min_ned_m);
   s.read("goal_max_ned_m", c.goal_max_ned_m);
+  s.read("random_start_fraction", c.random_start_fraction);
+  s.read("start_attitude_spread_rad", c.start_attitude_spread_rad);
+  s.read("start_velocity_max_body_mps", c.start_velocity_max_body_mps);
+  s.read("start_rate_max_body_rad_s", c.start_rate_max_body_rad_s);
   s.finish();
   try {
     c.validate();

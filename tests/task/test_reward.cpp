@@ -191,6 +191,18 @@ TEST(TaskConfig, ValidateRejectsUnusableValues) {
   c = TaskConfig{};
   c.distance_weight = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.random_start_fraction = 1.5;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.start_velocity_max_body_mps.y() = -0.1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.start_attitude_spread_rad.y() = c.flip_angle_rad;  // would start flipped
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.start_rate_max_body_rad_s.z() = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
 TEST(TaskConfig, ParsesNames) {

@@ -302,5 +302,80 @@ TEST(SampleGoal, DeterministicPerSeed) {
   EXPECT_EQ(sample_goal(point, a), Eigen::Vector3d(7.0, 6.0, 10.0));
 }
 
+TEST(SampleStart, AtRestAtTheStartPoseByDefault) {
+  TaskConfig c;
+  c.start_position_ned_m = Eigen::Vector3d(1.0, 2.0, 3.0);
+  c.start_yaw_rad = 0.4;
+  c.start_velocity_max_body_mps = Eigen::Vector3d(1.0, 1.0, 1.0);  // unused at fraction 0
+  std::mt19937_64 rng(9);
+  for (int i = 0; i < 100; ++i) {
+    const StartState s = sample_start(c, rng);
+    EXPECT_EQ(s.position_ned_m, c.start_position_ned_m);
+    EXPECT_EQ(s.euler_rpy_rad, Eigen::Vector3d(0.0, 0.0, 0.4));
+    EXPECT_EQ(s.velocity_body_mps, Eigen::Vector3d::Zero());
+    EXPECT_EQ(s.angular_rate_body_rad_s, Eigen::Vector3d::Zero());
+  }
+}
+
+TEST(SampleStart, RandomStartsHaveTheirShareAndStayInsideTheirSpreads) {
+  TaskConfig c;
+  c.random_start_fraction = 0.3;
+  c.start_yaw_rad = 3.0;  // near +pi: the drawn yaw must wrap
+  c.start_attitude_spread_rad = Eigen::Vector3d(0.1, 0.4, kPi);
+  c.start_velocity_max_body_mps = Eigen::Vector3d(1.5, 0.5, 0.25);
+  c.start_rate_max_body_rad_s = Eigen::Vector3d(0.2, 0.3, 0.6);
+  ASSERT_NO_THROW(c.validate());
+  std::mt19937_64 rng(17);
+  const int n = 20000;
+  int random = 0;
+  Eigen::Vector3d max_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_sum = Eigen::Vector3d::Zero();
+  double min_yaw = 10.0, max_yaw = -10.0;
+  for (int i = 0; i < n; ++i) {
+    const StartState s = sample_start(c, rng);
+    EXPECT_EQ(s.position_ned_m, c.start_position_ned_m);
+    if (s.velocity_body_mps.isZero() && s.euler_rpy_rad == Eigen::Vector3d(0.0, 0.0, 3.0)) {
+      EXPECT_TRUE(s.angular_rate_body_rad_s.isZero());
+      continue;
+    }
+    ++random;
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_LE(std::abs(s.euler_rpy_rad[k]), c.start_attitude_spread_rad[k]);
+    }
+    ASSERT_GT(s.euler_rpy_rad[2], -kPi - 1e-12);
+    ASSERT_LE(s.euler_rpy_rad[2], kPi + 1e-12);
+    min_yaw = std::min(min_yaw, s.euler_rpy_rad[2]);
+    max_yaw = std::max(max_yaw, s.euler_rpy_rad[2]);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_LE(std::abs(s.velocity_body_mps[k]), c.start_velocity_max_body_mps[k]);
+      ASSERT_LE(std::abs(s.angular_rate_body_rad_s[k]), c.start_rate_max_body_rad_s[k]);
+    }
+    max_velocity = max_velocity.cwiseMax(s.velocity_body_mps.cwiseAbs());
+    velocity_sum += s.velocity_body_mps;
+  }
+  EXPECT_NEAR(static_cast<double>(random) / n, 0.3, 0.02);
+  // A full yaw spread covers every heading; velocities reach their limits, centred on rest.
+  EXPECT_LT(min_yaw, -kPi + 0.01);
+  EXPECT_GT(max_yaw, kPi - 0.01);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(max_velocity[k], 0.99 * c.start_velocity_max_body_mps[k]);
+    EXPECT_NEAR(velocity_sum[k] / random, 0.0, 0.03 * c.start_velocity_max_body_mps[k]);
+  }
+}
+
+TEST(SampleStart, TakesTheSameDrawsEitherWaySoGoalsDoNotShift) {
+  // One stream for goals and starts would still give the same goals whatever the fraction.
+  TaskConfig rest, spread;
+  spread.random_start_fraction = 1.0;
+  spread.start_velocity_max_body_mps = Eigen::Vector3d(1.0, 1.0, 1.0);
+  std::mt19937_64 a(3), b(3);
+  for (int i = 0; i < 50; ++i) {
+    sample_start(rest, a);
+    const StartState s = sample_start(spread, b);
+    EXPECT_FALSE(s.velocity_body_mps.isZero());
+    EXPECT_EQ(sample_goal(rest, a), sample_goal(rest, b));
+  }
+}
+
 }  // namespace
 }  // namespace auvrl::task
