@@ -4,8 +4,14 @@
 
 namespace auvrl::agent {
 
-void read_actor_config_file(const std::string& path, ActorNodeConfig& c) {
+void read_actor_config_file(const std::string& path, ActorNodeConfig& c,
+                            std::string* vehicle_path) {
   config::Section root = config::load_file(path);
+  if (vehicle_path) {
+    std::string vehicle = *vehicle_path;
+    root.read("vehicle", vehicle);
+    if (!vehicle.empty()) *vehicle_path = config::resolve_path(root, vehicle);
+  }
   task::read_task_config(root.child("task"), c.task);
   const task::GoalSchedule schedule =
       task::read_goal_schedule(root.child("schedule"), task::GoalSchedule());
@@ -30,6 +36,10 @@ void read_actor_config_file(const std::string& path, ActorNodeConfig& c) {
   s.read("max_wait_s", c.max_wait_s);
   s.read("lockstep_timeout_ms", c.lockstep.timeout_ms);
   s.read("lockstep_attempts", c.lockstep.attempts);
+  s.read("demonstration_fraction", c.demonstration_fraction);
+  if (!(c.demonstration_fraction >= 0 && c.demonstration_fraction <= 1)) {
+    s.fail("demonstration_fraction", "must be in [0, 1]");
+  }
   if (c.lockstep.timeout_ms < 1) s.fail("lockstep_timeout_ms", "must be >= 1");
   if (c.lockstep.attempts < 1) s.fail("lockstep_attempts", "must be >= 1");
   s.finish();

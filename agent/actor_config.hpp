@@ -10,7 +10,9 @@
 namespace auvrl::agent {
 
 /// Reads task, schedule and actor from a run file into `config`. Throws config::ConfigError
-/// naming file and key.
-void read_actor_config_file(const std::string& path, ActorNodeConfig& config);
+/// naming file and key. The run file's vehicle (resolved against the file's folder) goes to
+/// `vehicle_path` when given: the demonstrator is built from it.
+void read_actor_config_file(const std::string& path, ActorNodeConfig& config,
+                            std::string* vehicle_path = nullptr);
 
 }  // namespace auvrl::agent

@@ -3,6 +3,7 @@
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/weights_request_t.hpp>
+#include <stdexcept>
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
@@ -45,8 +46,15 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
              config_.seed * 0x9E3779B97F4A7C15ull + 1),
       goal_rng_(config_.seed),
       start_rng_(config_.seed * 0xBF58476D1CE4E5B9ull + 7),
+      demonstration_rng_(config_.seed * 0x94D049BB133111EBull + 11),
       policy_(config_.task.state_dim(), config_.task.num_thrusters, config_.initial_beta_m) {
   config_.task.validate();
+  if (!(config_.demonstration_fraction >= 0 && config_.demonstration_fraction <= 1)) {
+    throw std::invalid_argument("actor.demonstration_fraction must be in [0, 1]");
+  }
+  if (config_.demonstration_fraction > 0 && !config_.demonstrator) {
+    throw std::invalid_argument("actor.demonstration_fraction > 0 needs a demonstrator");
+  }
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
 }
 
@@ -117,12 +125,17 @@ EpisodeSummary ActorNode::run_one_episode() {
   options.start.angular_rate_body_rad_s = start.angular_rate_body_rad_s;
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
   options.noise = &noise_;
+  // Drawn every episode, so the stream does not depend on the fraction's history.
+  const double demonstration_draw = static_cast<double>(demonstration_rng_() >> 11) * 0x1.0p-53;
+  last_was_demonstration_ = demonstration_draw < config_.demonstration_fraction;
+  Controller& controller = last_was_demonstration_ ? *config_.demonstrator : *controller_;
   std::vector<Transition> transitions;
   transitions.reserve(static_cast<std::size_t>(config_.task.max_steps));
   options.on_transition = [&transitions](const Transition& t) { transitions.push_back(t); };
 
-  const EpisodeSummary summary = run_episode(config_.task, *link_, *controller_, options);
+  const EpisodeSummary summary = run_episode(config_.task, *link_, controller, options);
   ++counters_.episodes;
+  if (last_was_demonstration_) ++counters_.demonstrations;
   counters_.steps += summary.length_steps;
   if (summary.end_reason == task::EndReason::kBlowUp ||
       summary.end_reason == task::EndReason::kSimTimeout) {
@@ -131,7 +144,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   } else {
     send_experience(transitions, options.goal_ned_m);
   }
-  send_report(summary, options.goal_ned_m);
+  if (!last_was_demonstration_) send_report(summary, options.goal_ned_m);
   return summary;
 }
 

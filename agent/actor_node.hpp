@@ -42,11 +42,19 @@ struct ActorNodeConfig {
   /// repeated command with the state it already computed), up to attempts times; then the
   /// episode ends (END_SIM_TIMEOUT). Each lost datagram costs one timeout_ms.
   LockstepTiming lockstep;
+  /// Demonstrations: this share of episodes is driven by `demonstrator` (with the same
+  /// exploration noise) instead of the policy. Their experience goes to the learner like any
+  /// other; they are not reported as episodes (success rates and the goal schedule are the
+  /// policy's). A policy that learns only from its own episodes found one way to every
+  /// way-point, turning round and reversing; the baseline's episodes show it another.
+  double demonstration_fraction = 0.0;
+  std::shared_ptr<Controller> demonstrator;  ///< required when demonstration_fraction > 0
 };
 
 /// Counters for logs and tests.
 struct ActorCounters {
   std::int64_t episodes = 0;
+  std::int64_t demonstrations = 0;  ///< of the episodes, those the demonstrator drove
   std::int64_t steps = 0;
   std::int64_t transitions_sent = 0;
   std::int64_t batches_sent = 0;
@@ -68,8 +76,10 @@ class ActorNode {
   ActorNode(const ActorNode&) = delete;
   ActorNode& operator=(const ActorNode&) = delete;
 
-  /// Runs one episode and reports it; returns its summary.
+  /// Runs one episode and reports it (a demonstration is not reported); returns its summary.
   EpisodeSummary run_one_episode();
+  /// Whether the last episode run was a demonstration.
+  bool last_was_demonstration() const { return last_was_demonstration_; }
 
   /// The learner said training is over.
   bool training_done() const { return policy_.training_done(); }
@@ -94,6 +104,8 @@ class ActorNode {
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
   std::mt19937_64 start_rng_;  ///< its own stream: exploring starts leave the goals unchanged
+  std::mt19937_64 demonstration_rng_;
+  bool last_was_demonstration_ = false;
   ActorCounters counters_;
   /// Waits (flow control) while the learner's backlog is above the configured limit.
   void wait_for_learner();

@@ -7,6 +7,7 @@
 
 #include "agent/actor_config.hpp"
 #include "agent/actor_node.hpp"
+#include "agent/pid_controller.hpp"
 #include "common/cli.hpp"
 #include "common/signals.hpp"
 #include "common/transport_options.hpp"
@@ -14,10 +15,11 @@
 int main(int argc, char** argv) {
   using namespace auvrl;
   agent::ActorNodeConfig config;
+  std::string vehicle_path;  // the demonstrator's model
   std::string config_path = cli::CommandLine::find_value(argc, argv, "config");
   if (!config_path.empty()) {
     try {
-      agent::read_actor_config_file(config_path, config);
+      agent::read_actor_config_file(config_path, config, &vehicle_path);
     } catch (const std::exception& e) {
       std::cerr << "auv_actor: " << e.what() << "\n";
       return 2;
@@ -57,6 +59,9 @@ int main(int argc, char** argv) {
   cmd.option("max-episodes", &config.max_episodes, "stop after this many (0: until stopped)");
   cmd.option("pin-cpu", &pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &report_every, "a log line every N episodes");
+  cmd.option("demonstration-fraction", &config.demonstration_fraction,
+             "share of episodes driven by the PID baseline (experience only, not reported)");
+  cmd.option("vehicle", &vehicle_path, "vehicle file of the PID demonstrator (YAML)");
   transport::add_transport_options(cmd, transport_config);
   transport::LockstepBusOptions lockstep_bus;
   transport::add_lockstep_options(cmd, lockstep_bus);
@@ -69,6 +74,14 @@ int main(int argc, char** argv) {
     config.vehicle_id = vehicle_id >= 0 ? vehicle_id : config.actor_id;
     config.seed = static_cast<std::uint64_t>(seed);
     config.task.validate();
+    if (config.demonstration_fraction > 0) {
+      if (vehicle_path.empty()) {
+        throw std::invalid_argument(
+            "demonstrations need the vehicle file (vehicle: in the run file, or --vehicle)");
+      }
+      config.demonstrator =
+          std::make_shared<agent::PidController>(sim::load_vehicle_file(vehicle_path));
+    }
   } catch (const std::exception& e) {
     std::cerr << "auv_actor: " << e.what() << "\n";
     return 2;
@@ -97,6 +110,7 @@ int main(int argc, char** argv) {
     while (!signals::stop_requested() && !node.training_done() &&
            (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
       const agent::EpisodeSummary s = node.run_one_episode();
+      if (node.last_was_demonstration()) continue;  // the window is the policy's
       return_sum += s.episode_return;
       successes += s.success ? 1 : 0;
       if (++window == report_every) {
