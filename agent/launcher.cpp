@@ -101,6 +101,9 @@ struct Role {
   int actor_id = -1;      ///< an actor's id (its signs of life are its EPISODE reports)
 };
 
+/// Seed of the quick evaluation's way-points (the reported suite uses seed 1).
+constexpr std::uint64_t kValidationSeed = 0x7A11DA7E;
+
 /// A quick score of a policy: reached count first, then faster and closer holding.
 struct QuickScore {
   int reached = 0;
@@ -119,10 +122,12 @@ QuickScore quick_evaluate(const sim::VehicleModel& model, const task::TaskConfig
   config.task = task;
   config.suite_episodes = suite_episodes;
   config.suite_trajectories = 0;
+  // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
+  // and the suite's seed 1) must not be the ones that choose the policy, or the reported
+  // times would be the best of many draws on the very tests.
+  config.seed = kValidationSeed;
   PolicyController controller(network, task.state_dim(), task.num_thrusters);
-  const auto rows =
-      run_evaluation(model, config, controller,
-                     {Scenario::kTest1, Scenario::kTest2, Scenario::kFault, Scenario::kSuite}, "");
+  const auto rows = run_evaluation(model, config, controller, {Scenario::kSuite}, "");
   QuickScore s;
   double time_sum = 0, hold_sum = 0;
   for (const SummaryRow& r : rows) {

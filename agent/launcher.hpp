@@ -15,11 +15,11 @@ namespace auvrl::agent {
 
 /// The `run:` section of a run configuration.
 struct RunSettings {
-  int actors = 0;                    ///< 0: one per CPU
-  std::uint64_t seed = 1;            ///< actor i uses seed * 1000 + i (+ a restart offset)
-  double max_train_s = 0.0;          ///< wall-clock training budget, s (0: until the learner ends)
-  double best_eval_period_s = 10.0;  ///< quick evaluation of the newest weights, s
-  int best_eval_suite = 20;          ///< way-points in that quick evaluation
+  int actors = 0;                   ///< 0: one per CPU
+  std::uint64_t seed = 1;           ///< actor i uses seed * 1000 + i (+ a restart offset)
+  double max_train_s = 0.0;         ///< wall-clock training budget, s (0: until the learner ends)
+  double best_eval_period_s = 5.0;  ///< quick evaluation of the newest weights, s
+  int best_eval_suite = 40;         ///< validation way-points in that quick evaluation
   /// CPU the learner is pinned to (-1: not pinned); actors then use the other CPUs.
   int learner_cpu = -1;
   /// Each simulator and its actor talk on a bus of their own (port 7668 + i), so nobody else
