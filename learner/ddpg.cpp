@@ -9,7 +9,6 @@
 #include "learner/ddpg.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -61,8 +60,6 @@ void DdpgConfig::validate() const {
   if (!(tau > 0.0f && tau <= 1.0f)) bad("tau must be in (0, 1]");
   if (actor_lr < 0.0f || critic_lr < 0.0f) bad("learning rates must be >= 0");
   if (td3_policy_delay < 1) bad("td3_policy_delay must be >= 1");
-  if (lr_half_life_updates < 0) bad("lr_half_life_updates must be >= 0");
-  if (!(lr_min_factor > 0.0f && lr_min_factor <= 1.0f)) bad("lr_min_factor must be in (0, 1]");
   if (td3_target_noise < 0.0f || td3_target_noise_clip < 0.0f) bad("TD3 noise must be >= 0");
   actor_spec(*this).validate();
   critic_spec(*this).validate();
@@ -112,14 +109,6 @@ UpdateStats Ddpg::update(const Batch& b) {
       b.action.rows() != config_.action_dim) {
     throw std::invalid_argument("Ddpg::update: minibatch of the wrong size or dims");
   }
-  if (config_.lr_half_life_updates > 0) {
-    const float factor = std::max(config_.lr_min_factor,
-                                  std::exp2(-static_cast<float>(updates_) /
-                                            static_cast<float>(config_.lr_half_life_updates)));
-    actor_opt_.set_learning_rate(config_.actor_lr * factor);
-    for (nn::Adam& opt : critic_opts_) opt.set_learning_rate(config_.critic_lr * factor);
-  }
-
   const auto x = b.state.leftCols(n);
   const auto u = b.action.leftCols(n);
   const auto r = b.reward.leftCols(n);

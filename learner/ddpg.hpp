@@ -49,13 +49,6 @@ struct DdpgConfig {
   float actor_grad_clip_norm = 0.0f;   ///< global-norm clipping of mu's gradient; 0: off
   float critic_grad_clip_norm = 0.0f;  ///< global-norm clipping of Q's gradient; 0: off
 
-  /// Learning-rate schedule: both rates halve every this many updates, down to
-  /// lr_min_factor times their configured value (0: constant rates). Late in a short run a
-  /// constant 1e-3 keeps moving the policy: its validation time swung by 2-5 s between
-  /// evaluations 5 s apart.
-  std::int64_t lr_half_life_updates = 0;
-  float lr_min_factor = 0.1f;
-
   float gamma = 0.99f;  ///< discount
   float tau = 1e-3f;    ///< soft target update rate (Eq. 7)
   int batch_size = 64;  ///< minibatch size m (also the largest batch the networks accept)
@@ -104,9 +97,6 @@ class Ddpg {
   const nn::Mlp& actor_target() const { return actor_target_; }
   /// Critic i (0, or 0 and 1 for TD3) and its target.
   const nn::Mlp& critic(int i = 0) const { return critics_[static_cast<std::size_t>(i)]; }
-  /// The learning rates the last update used (the schedule's, see lr_half_life_updates).
-  float actor_learning_rate() const { return actor_opt_.config().learning_rate; }
-  float critic_learning_rate() const { return critic_opts_.front().config().learning_rate; }
   const nn::Mlp& critic_target(int i = 0) const {
     return critic_targets_[static_cast<std::size_t>(i)];
   }

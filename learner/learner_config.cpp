@@ -31,8 +31,6 @@ void read_learner_section(config::Section s, LearnerNodeConfig& c) {
   s.read("td3_target_noise", d.td3_target_noise);
   s.read("td3_target_noise_clip", d.td3_target_noise_clip);
   s.read("td3_policy_delay", d.td3_policy_delay);
-  s.read("lr_half_life_updates", d.lr_half_life_updates);
-  s.read("lr_min_factor", d.lr_min_factor);
   s.read("seed", d.seed);
   s.read("updates_per_transition", c.updates_per_transition);
   s.read("warmup_transitions", c.warmup_transitions);

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -188,43 +187,6 @@ TEST(Ddpg, ZeroLearningRatesFreezeTheirNetworks) {
   const nn::Vector c0 = frozen_critic.critic().params();
   frozen_critic.update(random_batch(rng, 5, 2, 8, 0.1f));
   EXPECT_EQ(frozen_critic.critic().params(), c0);
-}
-
-// The schedule halves both rates every lr_half_life_updates, down to lr_min_factor of them; the
-// rate of an update follows from the updates before it, so a resumed learner continues it.
-TEST(Ddpg, LearningRatesFollowTheirSchedule) {
-  DdpgConfig config = small_config(Algo::kTd3);
-  config.actor_lr = 4e-3f;
-  config.critic_lr = 8e-3f;
-  config.lr_half_life_updates = 10;
-  config.lr_min_factor = 0.2f;
-  Ddpg learner(config);
-  nn::Rng rng(12);
-  const auto after = [&](int updates) {
-    while (learner.updates() < updates) learner.update(random_batch(rng, 5, 2, 8, 0.1f));
-  };
-  after(1);
-  EXPECT_FLOAT_EQ(learner.actor_learning_rate(), 4e-3f);
-  EXPECT_FLOAT_EQ(learner.critic_learning_rate(), 8e-3f);
-  after(11);  // the 11th update follows 10
-  EXPECT_FLOAT_EQ(learner.actor_learning_rate(), 2e-3f);
-  EXPECT_FLOAT_EQ(learner.critic_learning_rate(), 4e-3f);
-  after(16);
-  EXPECT_NEAR(learner.actor_learning_rate(), 4e-3f * std::exp2(-1.5f), 1e-9f);
-  after(61);  // 2^-6 is below the floor
-  EXPECT_FLOAT_EQ(learner.actor_learning_rate(), 0.2f * 4e-3f);
-  EXPECT_FLOAT_EQ(learner.critic_learning_rate(), 0.2f * 8e-3f);
-
-  // Off by default: the configured rates stay.
-  Ddpg constant(small_config(Algo::kTd3));
-  for (int i = 0; i < 30; ++i) constant.update(random_batch(rng, 5, 2, 8, 0.1f));
-  EXPECT_FLOAT_EQ(constant.actor_learning_rate(), small_config(Algo::kTd3).actor_lr);
-  DdpgConfig bad = small_config(Algo::kTd3);
-  bad.lr_min_factor = 0.0f;
-  EXPECT_THROW(Ddpg{bad}, std::invalid_argument);
-  bad = small_config(Algo::kTd3);
-  bad.lr_half_life_updates = -1;
-  EXPECT_THROW(Ddpg{bad}, std::invalid_argument);
 }
 
 // TD3: the actor and all targets move only every td3_policy_delay-th update.
