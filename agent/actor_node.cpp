@@ -126,8 +126,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
   options.noise = &noise_;
   // Drawn every episode, so the stream does not depend on the fraction's history.
-  const double demonstration_draw = static_cast<double>(demonstration_rng_() >> 11) * 0x1.0p-53;
-  last_was_demonstration_ = demonstration_draw < config_.demonstration_fraction;
+  last_was_demonstration_ = task::unit_draw(demonstration_rng_) < config_.demonstration_fraction;
   Controller& controller = last_was_demonstration_ ? *config_.demonstrator : *controller_;
   std::vector<Transition> transitions;
   transitions.reserve(static_cast<std::size_t>(config_.task.max_steps));

@@ -229,10 +229,9 @@ StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, 
   return out;
 }
 
-namespace {
-/// Uniform in [0, 1), portable (std::uniform_real_distribution differs between libraries).
 double unit_draw(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
+namespace {
 /// Uniform in centre +- half_width, per component.
 Eigen::Vector3d spread_draw(const Eigen::Vector3d& centre, const Eigen::Vector3d& half_width,
                             std::mt19937_64& rng) {
