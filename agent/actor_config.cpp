@@ -40,6 +40,7 @@ void read_actor_config_file(const std::string& path, ActorNodeConfig& c,
   if (!(c.demonstration_fraction >= 0 && c.demonstration_fraction <= 1)) {
     s.fail("demonstration_fraction", "must be in [0, 1]");
   }
+  s.read("expert_labels", c.expert_labels);
   if (c.lockstep.timeout_ms < 1) s.fail("lockstep_timeout_ms", "must be >= 1");
   if (c.lockstep.attempts < 1) s.fail("lockstep_attempts", "must be >= 1");
   s.finish();

@@ -55,6 +55,10 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
   if (config_.demonstration_fraction > 0 && !config_.demonstrator) {
     throw std::invalid_argument("actor.demonstration_fraction > 0 needs a demonstrator");
   }
+  if (config_.expert_labels && !config_.expert) {
+    throw std::invalid_argument("actor.expert_labels needs an expert controller");
+  }
+  if (!config_.expert_labels) config_.expert.reset();
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
 }
 
@@ -125,6 +129,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   options.start.angular_rate_body_rad_s = start.angular_rate_body_rad_s;
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
   options.noise = &noise_;
+  options.expert = config_.expert.get();
   // Drawn every episode, so the stream does not depend on the fraction's history.
   last_was_demonstration_ = task::unit_draw(demonstration_rng_) < config_.demonstration_fraction;
   Controller& controller = last_was_demonstration_ ? *config_.demonstrator : *controller_;
@@ -165,6 +170,7 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
     msg.state_dim = state_dim;
     msg.action_dim = action_dim;
     msg.num_transitions = static_cast<std::int32_t>(end - begin);
+    msg.expert_action_dim = config_.expert ? action_dim : 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Transition& t = transitions[i];
       msg.states.emplace_back(t.state.data(), t.state.data() + state_dim);
@@ -178,6 +184,10 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
       msg.goal_ned_m.push_back(goal_row);
       msg.episode_id.push_back(episode_id_);
       msg.step_index.push_back(t.step_index);
+      if (config_.expert) {
+        msg.expert_actions.emplace_back(t.expert_action.data(),
+                                        t.expert_action.data() + action_dim);
+      }
     }
     transport::publish(transport_, channels::kExperience, msg);
     counters_.transitions_sent += msg.num_transitions;

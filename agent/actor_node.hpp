@@ -49,6 +49,12 @@ struct ActorNodeConfig {
   /// way-point, turning round and reversing; the baseline's episodes show it another.
   double demonstration_fraction = 0.0;
   std::shared_ptr<Controller> demonstrator;  ///< required when demonstration_fraction > 0
+  /// Expert labels (actor.expert_labels): every transition sent carries what `expert` (its own
+  /// instance, e.g. the PID baseline) would have commanded in that state, for the learner's
+  /// Q-filtered imitation term. The expert never drives. The run file's flag says whether auv_actor
+  /// builds one.
+  bool expert_labels = false;
+  std::shared_ptr<Controller> expert;  ///< required when expert_labels
 };
 
 /// Counters for logs and tests.

@@ -61,7 +61,9 @@ int main(int argc, char** argv) {
   cmd.option("report-every", &report_every, "a log line every N episodes");
   cmd.option("demonstration-fraction", &config.demonstration_fraction,
              "share of episodes driven by the PID baseline (experience only, not reported)");
-  cmd.option("vehicle", &vehicle_path, "vehicle file of the PID demonstrator (YAML)");
+  cmd.flag("expert-labels", &config.expert_labels,
+           "label every transition with the PID baseline's command (the learner's imitation)");
+  cmd.option("vehicle", &vehicle_path, "vehicle file of the PID demonstrator/expert (YAML)");
   transport::add_transport_options(cmd, transport_config);
   transport::LockstepBusOptions lockstep_bus;
   transport::add_lockstep_options(cmd, lockstep_bus);
@@ -74,13 +76,18 @@ int main(int argc, char** argv) {
     config.vehicle_id = vehicle_id >= 0 ? vehicle_id : config.actor_id;
     config.seed = static_cast<std::uint64_t>(seed);
     config.task.validate();
-    if (config.demonstration_fraction > 0) {
+    if (config.demonstration_fraction > 0 || config.expert_labels) {
       if (vehicle_path.empty()) {
         throw std::invalid_argument(
-            "demonstrations need the vehicle file (vehicle: in the run file, or --vehicle)");
+            "demonstrations and expert labels need the vehicle file (vehicle: in the run file, "
+            "or --vehicle)");
       }
-      config.demonstrator =
-          std::make_shared<agent::PidController>(sim::load_vehicle_file(vehicle_path));
+      const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path);
+      // Two instances: the PID keeps integrator state per episode it follows.
+      if (config.demonstration_fraction > 0) {
+        config.demonstrator = std::make_shared<agent::PidController>(model);
+      }
+      if (config.expert_labels) config.expert = std::make_shared<agent::PidController>(model);
     }
   } catch (const std::exception& e) {
     std::cerr << "auv_actor: " << e.what() << "\n";

@@ -58,6 +58,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
   }
   EpisodeSummary summary;
   controller.reset();
+  if (options.expert) options.expert->reset();
   if (options.noise) options.noise->reset();
 
   std::optional<VehicleReport> report = link.reset(options.start);
@@ -72,6 +73,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
   const Eigen::Vector3d& goal = options.goal_ned_m;
   task::ActionVector previous_action = task::ActionVector::Zero(n);
   task::ActionVector action(n);
+  task::ActionVector expert_action;
   task::StateVector state, next_state;
   task::build_state(task, report->observation, goal, previous_action, state,
                     report->thrust_realised_n);
@@ -84,6 +86,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
 
   for (int t = 1; t <= task.max_steps; ++t) {
     controller.act(report->observation, goal, state, action);
+    if (options.expert) options.expert->act(report->observation, goal, state, expert_action);
     if (options.noise) options.noise->apply(action);
     for (int i = 0; i < n; ++i) {
       thrust_n[static_cast<std::size_t>(i)] = static_cast<double>(action[i]) * task.max_thrust_n;
@@ -107,7 +110,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
       if (options.on_transition) {
         Transition tr{state,      action,           outcome.reward,
                       next_state, outcome.terminal, next->observation.position_ned_m,
-                      t - 1};
+                      t - 1,      expert_action};
         options.on_transition(tr);
       }
       summary.episode_return += outcome.reward;

@@ -45,6 +45,8 @@ struct Transition {
   bool terminal = false;
   Eigen::Vector3d achieved_position_ned_m = Eigen::Vector3d::Zero();
   int step_index = 0;
+  /// What EpisodeOptions::expert would have commanded in `state` (empty without an expert).
+  task::ActionVector expert_action;
 };
 
 /// One control step as recorded for trajectories and plots.
@@ -82,6 +84,9 @@ struct EpisodeOptions {
   /// vehicle hold station). Failures still end the episode.
   bool run_full_time = false;
   ExplorationNoise* noise = nullptr;  ///< none: the controller alone
+  /// Labels every transition with what this controller would have commanded (it is reset with
+  /// the episode and asked every step, but never drives). None: no labels.
+  Controller* expert = nullptr;
   /// Called with every transition (not for a blown-up step).
   std::function<void(const Transition&)> on_transition;
   std::vector<TrajectoryRow>* trajectory = nullptr;  ///< recorded when given

@@ -272,7 +272,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     episodes_csv << "wall_s,actor_id,episode_id,policy_version,return,length_steps,success,"
                     "final_distance_m,min_distance_m,beta_m,end_reason,thrust_energy\n";
     learner_csv << "wall_s,updates,updates_per_s,transitions_received,transitions_per_s,"
-                   "buffer_size,critic_loss,actor_loss,mean_q,episodes,beta_m,weights_published\n";
+                   "buffer_size,critic_loss,actor_loss,mean_q,episodes,beta_m,weights_published,"
+                   "expert_share\n";
     progress_csv << "wall_s,episodes,success_rate,beta_m,env_steps_per_s,updates_per_s,"
                     "best_suite_success\n";
   }
@@ -312,7 +313,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                     << ',' << s.transitions_per_s << ',' << s.buffer_size << ','
                     << std::setprecision(6) << s.critic_loss << ',' << s.actor_loss << ','
                     << s.mean_q << ',' << s.episodes << ',' << s.beta_m << ','
-                    << s.weights_published << '\n';
+                    << s.weights_published << ',' << s.expert_share << '\n';
       });
   std::map<int, std::pair<double, std::int64_t>> sim_steps;  // pid -> (rate, total)
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(

@@ -9,6 +9,7 @@
 #include "learner/ddpg.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
@@ -61,6 +62,9 @@ void DdpgConfig::validate() const {
   if (actor_lr < 0.0f || critic_lr < 0.0f) bad("learning rates must be >= 0");
   if (td3_policy_delay < 1) bad("td3_policy_delay must be >= 1");
   if (td3_target_noise < 0.0f || td3_target_noise_clip < 0.0f) bad("TD3 noise must be >= 0");
+  if (!(expert_weight >= 0.0f) || !std::isfinite(expert_weight)) {
+    bad("expert_weight must be finite and >= 0");
+  }
   actor_spec(*this).validate();
   critic_spec(*this).validate();
 }
@@ -78,7 +82,9 @@ Ddpg::Ddpg(const DdpgConfig& config)
       noise_(nn::Matrix::Zero(config.action_dim, config.batch_size)),
       target_q_(nn::Matrix::Zero(1, config.batch_size)),
       y_(nn::Matrix::Zero(1, config.batch_size)),
-      dq_(nn::Matrix::Zero(1, config.batch_size)) {
+      dq_(nn::Matrix::Zero(1, config.batch_size)),
+      q_expert_(nn::Matrix::Zero(1, config.batch_size)),
+      dmu_(nn::Matrix::Zero(config.action_dim, config.batch_size)) {
   // Line 1: initialise mu and Q (Lillicrap's scheme), from the seed.
   actor_.init_lillicrap(rng_);
   const int num_critics = config_.algo == Algo::kTd3 ? 2 : 1;
@@ -154,7 +160,7 @@ UpdateStats Ddpg::update(const Batch& b) {
 
   // Lines 18-20, every update for DDPG, every td3_policy_delay-th for TD3.
   if (!td3 || updates_ % config_.td3_policy_delay == 0) {
-    actor_step(x, stats);
+    actor_step(b, stats);
     // Lines 19-20: theta' <- tau theta + (1 - tau) theta', w' <- tau w + (1 - tau) w' (Eq. 7).
     nn::soft_update(actor_target_, actor_, config_.tau);
     for (std::size_t k = 0; k < critics_.size(); ++k) {
@@ -162,22 +168,47 @@ UpdateStats Ddpg::update(const Batch& b) {
     }
   }
   stats.actor_loss = last_actor_loss_;
+  stats.expert_share = last_expert_share_;
   return stats;
 }
 
 // Line 18: deterministic policy gradient (Eq. 12). The actor minimises
 // J(theta) = -1/N sum Q(x_i, mu(x_i | theta)), so dJ/dtheta = -1/N sum dQ/du * dmu/dtheta:
 // dQ/du comes from the (just updated) critic's backward pass to its action input, then runs
-// back through the actor.
-void Ddpg::actor_step(const nn::ConstMatrixRef& x, UpdateStats& stats) {
-  const Eigen::Index n = x.cols();
+// back through the actor. With expert_weight, the Q-filtered imitation term (see DdpgConfig)
+// adds c * m_i * (mu(x_i) - a^E_i) to dJ/dmu, c = 2 * weight * mean|Q| / (N * action_dim).
+void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
+  const Eigen::Index n = b.size;
+  const auto x = b.state.leftCols(n);
+  const bool imitate = config_.expert_weight > 0.0f && b.has_expert.leftCols(n).sum() > 0.0f;
+  auto q_expert = q_expert_.leftCols(n);
+  if (imitate && config_.expert_q_filter) {
+    // Before the policy's own forward pass: the backward pass needs that one's activations.
+    q_expert = critics_[0].forward(x, b.expert_action.leftCols(n));
+  }
   const auto mu = actor_.forward(x);
   const auto q = critics_[0].forward(x, mu);
   last_actor_loss_ = -q.mean();
   auto dq = dq_.leftCols(n);
   dq.setConstant(-1.0f / static_cast<float>(n));
   critics_[0].backward(dq, nn::GradRequest{false, false, true});
-  actor_.backward(critics_[0].extra_input_grad(), nn::GradRequest{true, false, false});
+  auto dmu = dmu_.leftCols(n);
+  dmu = critics_[0].extra_input_grad();
+  last_expert_share_ = 0.0f;
+  if (imitate) {
+    const float c = 2.0f * config_.expert_weight * q.cwiseAbs().mean() /
+                    static_cast<float>(n * config_.action_dim);
+    int applied = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const bool use =
+          b.has_expert(0, i) > 0.5f && (!config_.expert_q_filter || q_expert(0, i) > q(0, i));
+      if (!use) continue;
+      dmu.col(i) += c * (mu.col(i) - b.expert_action.col(i));
+      ++applied;
+    }
+    last_expert_share_ = static_cast<float>(applied) / static_cast<float>(n);
+  }
+  actor_.backward(dmu, nn::GradRequest{true, false, false});
   stats.actor_grad_norm = actor_opt_.step(actor_);
   stats.actor_updated = true;
   ++actor_updates_;

@@ -60,6 +60,20 @@ struct DdpgConfig {
   float td3_target_noise_clip = 0.5f;  ///< the noise is clipped to +-this
   int td3_policy_delay = 2;            ///< critic updates per actor and target update
 
+  /// Q-filtered imitation of an expert (Nair et al. 2018, "Overcoming exploration in RL with
+  /// demonstrations"): the actor's loss gains
+  ///   expert_weight * mean|Q| * 1/N sum_i m_i * mean_j (mu_j(x_i) - a^E_ij)^2,
+  /// where a^E is the expert's label stored with the transition and m_i = 1 only where the
+  /// transition has a label and the critic rates the expert's action above the policy's
+  /// (Q(x_i, a^E_i) > Q(x_i, mu(x_i))), so the policy copies the expert only where the expert is
+  /// better and is free to surpass it elsewhere. mean|Q| (not differentiated) makes the weight
+  /// independent of the reward's scale, as in TD3+BC (Fujimoto and Gu 2021; its alpha = 2.5
+  /// is a weight of 0.4 here). 0: off.
+  float expert_weight = 0.0f;
+  /// Apply the imitation term only where the critic prefers the expert's action (the Q
+  /// filter); false: wherever there is a label.
+  bool expert_q_filter = true;
+
   std::uint64_t seed = 1;  ///< initial weights, minibatch sampling and TD3 noise
 
   /// Throws std::invalid_argument naming the first unusable value.
@@ -74,6 +88,9 @@ struct UpdateStats {
   bool actor_updated = false;  ///< false on TD3's delayed steps
   float critic_grad_norm = 0;  ///< global norm of the (first) critic's loss gradient
   float actor_grad_norm = 0;   ///< global norm of the actor's loss gradient (if updated)
+  /// Share of the actor step's minibatch the imitation term applied to (labelled and, with
+  /// the Q filter, rated better than the policy); 0 without expert_weight.
+  float expert_share = 0;
 };
 
 /// The learner's networks, optimisers and update rule. Construction is Algorithm 1's lines 1-2
@@ -123,7 +140,7 @@ class Ddpg {
   void restore(nn::Reader& r);
 
  private:
-  void actor_step(const nn::ConstMatrixRef& x, UpdateStats& stats);
+  void actor_step(const Batch& b, UpdateStats& stats);
 
   DdpgConfig config_;
   nn::Rng rng_;
@@ -143,6 +160,9 @@ class Ddpg {
   nn::Matrix target_q_;     // Q'(x_{i+1}, u'_{i+1}) (1 x m)
   nn::Matrix y_;            // targets y_i (1 x m)
   nn::Matrix dq_;           // dL/dQ (1 x m)
+  nn::Matrix q_expert_;     // Q(x_i, a^E_i) (1 x m)
+  nn::Matrix dmu_;          // dL/dmu (action_dim x m)
+  float last_expert_share_ = 0;
 };
 
 }  // namespace auvrl::learner

@@ -82,6 +82,8 @@ void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::
     batch.next_state.col(i) = next_state;
     batch.reward(0, i) = static_cast<float>(outcome.reward);
     batch.terminal(0, i) = outcome.terminal ? 1.0f : 0.0f;
+    // The expert's label was for the old goal.
+    batch.has_expert(0, i) = 0.0f;
     ++relabelled_;
   }
 }

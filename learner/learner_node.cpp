@@ -116,18 +116,24 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
   if (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim ||
       n < 1 || n > config_.max_transitions_per_batch || !rows_ok(msg.states, msg.state_dim) ||
       !rows_ok(msg.next_states, msg.state_dim) || !rows_ok(msg.actions, msg.action_dim) ||
-      !rows_ok(msg.achieved_position_ned_m, 3) || !rows_ok(msg.goal_ned_m, 3)) {
+      !rows_ok(msg.achieved_position_ned_m, 3) || !rows_ok(msg.goal_ned_m, 3) ||
+      (msg.expert_action_dim != 0 && msg.expert_action_dim != msg.action_dim) ||
+      (msg.expert_action_dim != 0 && !rows_ok(msg.expert_actions, msg.expert_action_dim))) {
     ++counters_.dropped_dims;
     return;
   }
   const bool finite =
       all_finite(msg.states) && all_finite(msg.next_states) && all_finite(msg.actions) &&
       all_finite(msg.achieved_position_ned_m) && all_finite(msg.goal_ned_m) &&
+      all_finite(msg.expert_actions) &&
       std::all_of(msg.rewards.begin(), msg.rewards.end(), [](float r) { return std::isfinite(r); });
   // Actions come out of tanh: anything beyond [-1, 1] did not come from a policy.
-  const bool actions_in_range = std::all_of(msg.actions.begin(), msg.actions.end(), [](auto& a) {
-    return std::all_of(a.begin(), a.end(), [](float v) { return std::abs(v) <= 1.0f + 1e-6f; });
-  });
+  const auto in_range = [](const std::vector<std::vector<float>>& rows) {
+    return std::all_of(rows.begin(), rows.end(), [](auto& a) {
+      return std::all_of(a.begin(), a.end(), [](float v) { return std::abs(v) <= 1.0f + 1e-6f; });
+    });
+  };
+  const bool actions_in_range = in_range(msg.actions) && in_range(msg.expert_actions);
   if (!finite || !actions_in_range) {
     ++counters_.dropped_non_finite;
     return;
@@ -154,7 +160,9 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
         (static_cast<std::uint64_t>(msg.actor_id) << 40) |
             (static_cast<std::uint64_t>(msg.episode_id[static_cast<std::size_t>(i)]) &
              ((std::uint64_t{1} << 40) - 1)),
-        static_cast<std::uint32_t>(msg.step_index[static_cast<std::size_t>(i)])};
+        static_cast<std::uint32_t>(msg.step_index[static_cast<std::size_t>(i)]),
+        msg.expert_action_dim != 0 ? msg.expert_actions[static_cast<std::size_t>(i)].data()
+                                   : nullptr};
     const std::size_t slot = replay_->next_slot();
     const bool overwrote = replay_->size() == replay_->capacity();
     const std::uint64_t overwritten_episode = overwrote ? replay_->episode_id(slot) : 0;
@@ -202,6 +210,10 @@ void LearnerNode::run_updates() {
     interval_critic_loss_ += stats.critic_loss;
     interval_actor_loss_ += stats.actor_loss;
     interval_mean_q_ += stats.mean_q;
+    if (stats.actor_updated) {
+      interval_expert_share_ += stats.expert_share;
+      ++interval_actor_updates_;
+    }
     maybe_publish_weights();
   }
 }
@@ -278,9 +290,13 @@ void LearnerNode::publish_stats() {
       s.dropped_dims + s.dropped_non_finite + s.dropped_unknown_actor + decode_stats_.failed;
   s.batches_lost = counters_.batches_lost;
   s.checkpoints_written = counters_.checkpoints_written;
+  s.expert_share = interval_actor_updates_ > 0
+                       ? interval_expert_share_ / static_cast<double>(interval_actor_updates_)
+                       : 0.0;
   transport::publish(transport_, channels::kLearnerStats, s);
   interval_updates_ = interval_transitions_ = 0;
-  interval_critic_loss_ = interval_actor_loss_ = interval_mean_q_ = 0.0;
+  interval_critic_loss_ = interval_actor_loss_ = interval_mean_q_ = interval_expert_share_ = 0.0;
+  interval_actor_updates_ = 0;
   interval_start_ = now;
   next_stats_ = now + seconds(config_.stats_period_s);
 }

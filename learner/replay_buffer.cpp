@@ -1,5 +1,6 @@
 #include "learner/replay_buffer.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -7,7 +8,8 @@ namespace auvrl::learner {
 namespace {
 
 constexpr char kMagic[8] = {'A', 'U', 'V', 'R', 'L', 'R', 'B', '\0'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersionWithoutExpert = 1;
 
 // Prefetches every cache line of column i of m.
 void prefetch_column(const nn::Matrix& m, Eigen::Index i) {
@@ -25,6 +27,8 @@ Batch::Batch(int state_dim, int action_dim, int max_batch)
       reward(nn::Matrix::Zero(1, max_batch)),
       next_state(nn::Matrix::Zero(state_dim, max_batch)),
       terminal(nn::Matrix::Zero(1, max_batch)),
+      expert_action(nn::Matrix::Zero(action_dim, max_batch)),
+      has_expert(nn::Matrix::Zero(1, max_batch)),
       slot(static_cast<std::size_t>(max_batch), 0) {}
 
 ReplayBuffer::ReplayBuffer(int state_dim, int action_dim, std::size_t capacity)
@@ -43,6 +47,8 @@ ReplayBuffer::ReplayBuffer(int state_dim, int action_dim, std::size_t capacity)
   goals_.resize(3, cap);
   episode_ids_.resize(capacity);
   step_indices_.resize(capacity);
+  has_expert_.resize(capacity);
+  expert_actions_.resize(action_dim, cap);
 }
 
 void ReplayBuffer::add(const TransitionView& t) {
@@ -64,6 +70,12 @@ void ReplayBuffer::add(const TransitionView& t) {
   goals_.col(i) = t.goal_ned_m;
   episode_ids_[next_] = t.episode_id;
   step_indices_[next_] = t.step_index;
+  has_expert_[next_] = t.expert_action ? 1 : 0;
+  if (t.expert_action) {
+    expert_actions_.col(i) = Eigen::Map<const nn::Vector>(t.expert_action, action_dim_);
+  } else {
+    expert_actions_.col(i).setZero();
+  }
   next_ = next_ + 1 == capacity_ ? 0 : next_ + 1;
   if (size_ < capacity_) ++size_;
   ++total_added_;
@@ -87,6 +99,8 @@ void ReplayBuffer::sample(nn::Rng& rng, int n, Batch& out) const {
     prefetch_column(next_states_, i);
     __builtin_prefetch(&rewards_[slot]);
     __builtin_prefetch(&terminal_[slot]);
+    __builtin_prefetch(&has_expert_[slot]);
+    prefetch_column(expert_actions_, i);
   }
   for (int k = 0; k < n; ++k) {
     const std::uint64_t slot = out.slot[static_cast<std::size_t>(k)];
@@ -96,6 +110,8 @@ void ReplayBuffer::sample(nn::Rng& rng, int n, Batch& out) const {
     out.reward(0, k) = rewards_[slot];
     out.next_state.col(k) = next_states_.col(i);
     out.terminal(0, k) = terminal_[slot] ? 1.0f : 0.0f;
+    out.has_expert(0, k) = has_expert_[slot] ? 1.0f : 0.0f;
+    out.expert_action.col(k) = expert_actions_.col(i);
   }
 }
 
@@ -130,6 +146,8 @@ void ReplayBuffer::save(nn::Writer& w) const {
   w.f32_array(goals_.data(), 3 * n);
   w.u64_array(episode_ids_.data(), n);
   w.u32_array(step_indices_.data(), n);
+  w.bytes(has_expert_.data(), n);
+  w.f32_array(expert_actions_.data(), n * static_cast<std::size_t>(action_dim_));
   w.checksum();
 }
 
@@ -142,9 +160,9 @@ void ReplayBuffer::restore(std::istream& is) {
 void ReplayBuffer::restore(nn::Reader& r) {
   r.expect_magic(kMagic);
   const std::uint32_t version = r.u32();
-  if (version != kVersion) {
+  if (version != kVersion && version != kVersionWithoutExpert) {
     r.fail("unsupported format version " + std::to_string(version) + ", expected " +
-           std::to_string(kVersion));
+           std::to_string(kVersionWithoutExpert) + " or " + std::to_string(kVersion));
   }
   const std::uint32_t state_dim = r.u32();
   const std::uint32_t action_dim = r.u32();
@@ -174,6 +192,14 @@ void ReplayBuffer::restore(nn::Reader& r) {
   r.f32_array(fresh.goals_.data(), 3 * n);
   r.u64_array(fresh.episode_ids_.data(), n);
   r.u32_array(fresh.step_indices_.data(), n);
+  if (version == kVersion) {
+    r.bytes(fresh.has_expert_.data(), n);
+    r.f32_array(fresh.expert_actions_.data(), n * action_dim);
+  } else {
+    std::fill(fresh.has_expert_.begin(), fresh.has_expert_.begin() + static_cast<std::ptrdiff_t>(n),
+              std::uint8_t{0});
+    fresh.expert_actions_.leftCols(static_cast<Eigen::Index>(n)).setZero();
+  }
   r.verify_checksum();
   fresh.size_ = n;
   fresh.next_ = next;

@@ -28,6 +28,9 @@ struct TransitionView {
   Eigen::Vector3f goal_ned_m;               ///< the episode's way-point, NED, m
   std::uint64_t episode_id;                 ///< unique per episode (across actors)
   std::uint32_t step_index;                 ///< t within the episode, from 0
+  /// What the expert (the PID baseline) would have commanded in x_t: action_dim values in
+  /// [-1, 1], or none (nullptr) when the actor sent no label.
+  const float* expert_action = nullptr;
 };
 
 /// A minibatch, one column per transition, preallocated for up to max_batch transitions; only
@@ -41,6 +44,8 @@ struct Batch {
   nn::Matrix reward;      ///< 1 x max_batch
   nn::Matrix next_state;  ///< state_dim x max_batch
   nn::Matrix terminal;    ///< 1 x max_batch: 1 where terminal, else 0 (so targets use 1 - terminal)
+  nn::Matrix expert_action;         ///< action_dim x max_batch: the expert's label (0 where none)
+  nn::Matrix has_expert;            ///< 1 x max_batch: 1 where expert_action is a label, else 0
   std::vector<std::uint64_t> slot;  ///< buffer slot of each sampled transition
 
   int max_batch() const { return static_cast<int>(state.cols()); }
@@ -51,7 +56,7 @@ struct Batch {
 /// generator, so a run is reproducible. Not thread-safe.
 class ReplayBuffer {
  public:
-  /// Allocates all storage now (4 * (2 * state_dim + action_dim + 7) + 13 bytes per slot).
+  /// Allocates all storage now (4 * (2 * state_dim + 2 * action_dim + 7) + 14 bytes per slot).
   ReplayBuffer(int state_dim, int action_dim, std::size_t capacity);
 
   /// Stores a transition (throws std::invalid_argument on wrong sizes). Allocates nothing.
@@ -86,13 +91,18 @@ class ReplayBuffer {
   auto goal_ned_m(std::size_t slot) const { return goals_.col(static_cast<Eigen::Index>(slot)); }
   std::uint64_t episode_id(std::size_t slot) const { return episode_ids_[slot]; }
   std::uint32_t step_index(std::size_t slot) const { return step_indices_[slot]; }
+  bool has_expert(std::size_t slot) const { return has_expert_[slot] != 0; }
+  auto expert_action(std::size_t slot) const {
+    return expert_actions_.col(static_cast<Eigen::Index>(slot));
+  }
 
   /// Writes the whole content as one self-checking record:
-  ///   char[8] "AUVRLRB\0", u32 version (1), u32 state_dim, u32 action_dim, u64 capacity,
+  ///   char[8] "AUVRLRB\0", u32 version (2), u32 state_dim, u32 action_dim, u64 capacity,
   ///   u64 size, u64 next slot, u64 total added, then for slots [0, size): states (f32),
   ///   actions (f32), rewards (f32), next states (f32), terminal flags (u8), achieved positions
-  ///   (3 f32), goals (3 f32), episode ids (u64), step indices (u32); then the CRC-32 of all of
-  ///   it. Little-endian.
+  ///   (3 f32), goals (3 f32), episode ids (u64), step indices (u32), expert flags (u8),
+  ///   expert actions (f32, action_dim each); then the CRC-32 of all of it. Little-endian.
+  ///   Version 1 (no expert fields) is read as transitions without labels.
   void save(std::ostream& os) const;
   void save(nn::Writer& w) const;
   /// Replaces the content with a record written by save(). Dimensions and capacity must equal
@@ -117,6 +127,8 @@ class ReplayBuffer {
   Eigen::Matrix<float, 3, Eigen::Dynamic> goals_;
   std::vector<std::uint64_t> episode_ids_;
   std::vector<std::uint32_t> step_indices_;
+  std::vector<std::uint8_t> has_expert_;
+  nn::Matrix expert_actions_;
 };
 
 }  // namespace auvrl::learner

@@ -1,5 +1,6 @@
 // DDPG/TD3 update: targets and losses against a hand computation, terminal handling, which
-// networks move when, TD3's delay, allocation-free updates, and exact save/restore.
+// networks move when, TD3's delay, the Q-filtered imitation term (gradient against finite
+// differences, the filter, its effect), allocation-free updates, and exact save/restore.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 false positive in Eigen AVX-512
 #pragma GCC diagnostic ignored "-Wuninitialized"
@@ -7,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 #include <string>
 
@@ -209,6 +211,131 @@ TEST(Ddpg, Td3DelaysActorAndTargetUpdates) {
   EXPECT_NE(learner.critic_target(1).params(), target0);
   EXPECT_EQ(learner.updates(), 3);
   EXPECT_EQ(learner.actor_updates(), 1);
+}
+
+// Expert labels on every column of b (action_dim x n), with has_expert where `labelled`.
+void label(Batch& b, nn::Rng& rng, float labelled_fraction) {
+  for (int k = 0; k < b.size; ++k) {
+    b.has_expert(0, k) = nn::uniform01(rng) < labelled_fraction ? 1.0f : 0.0f;
+    for (int i = 0; i < b.expert_action.rows(); ++i)
+      b.expert_action(i, k) = nn::uniform(rng, -1, 1);
+  }
+}
+
+// The actor's loss with the imitation term, as DdpgConfig documents it, evaluated on the side:
+// -mean Q(x, mu(x)) + weight * q_scale * 1/N sum_i m_i mean_j (mu_ij - a^E_ij)^2, with the scale
+// and the mask held fixed (they are not differentiated).
+double imitation_loss(const nn::Mlp& actor, const nn::Mlp& critic, const Batch& b,
+                      const std::vector<bool>& mask, double weight, double q_scale) {
+  const int n = b.size;
+  const nn::Matrix x = b.state.leftCols(n);
+  const nn::Matrix mu = eval(actor, x);
+  const nn::Matrix q = eval(critic, x, mu);
+  double loss = -static_cast<double>(q.mean());
+  for (int i = 0; i < n; ++i) {
+    if (!mask[static_cast<std::size_t>(i)]) continue;
+    const double sq = (mu.col(i) - b.expert_action.col(i)).cast<double>().squaredNorm();
+    loss += weight * q_scale * sq / (n * mu.rows());
+  }
+  return loss;
+}
+
+// The actor's gradient with the Q-filtered imitation term against central differences of the
+// loss above along the gradient and along a random direction, and the filter's mask against
+// the critic evaluated on the side. The critic first learns from large rewards so that
+// mean|Q| (the term's scale) is far from its near-zero initial value; the actor's learning
+// rate is 0, so the gradient is taken at the actor's initial parameters.
+TEST(Ddpg, ImitationTermGradientMatchesFiniteDifferences) {
+  for (bool q_filter : {false, true}) {
+    DdpgConfig config = small_config(Algo::kDdpg);
+    config.actor_lr = 0.0f;
+    config.critic_lr = 1e-2f;
+    config.critic_weight_decay = 0.0f;
+    config.expert_weight = 0.5f;
+    config.expert_q_filter = q_filter;
+    Ddpg learner(config);
+    nn::Rng rng(21);
+    Batch b = random_batch(rng, 5, 2, 8, 0.0f);
+    b.reward.leftCols(b.size).array() += 20.0f;
+    label(b, rng, 0.75f);
+    for (int i = 0; i < 200; ++i) learner.update(b);
+    const nn::Mlp actor0 = learner.actor();
+
+    const UpdateStats stats = learner.update(b);
+    ASSERT_TRUE(stats.actor_updated);
+    const nn::Vector grad = learner.actor().grads();
+    const nn::Mlp& critic = learner.critic();  // the actor step used the just-updated critic
+
+    const nn::Matrix x = b.state.leftCols(b.size);
+    const nn::Matrix mu0 = eval(actor0, x);
+    const nn::Matrix q_mu = eval(critic, x, mu0);
+    const nn::Matrix q_expert = eval(critic, x, b.expert_action.leftCols(b.size));
+    std::vector<bool> mask, none(static_cast<std::size_t>(b.size), false);
+    int applied = 0;
+    for (int i = 0; i < b.size; ++i) {
+      mask.push_back(b.has_expert(0, i) > 0.5f && (!q_filter || q_expert(0, i) > q_mu(0, i)));
+      applied += mask.back() ? 1 : 0;
+    }
+    EXPECT_FLOAT_EQ(stats.expert_share, static_cast<float>(applied) / b.size);
+    const double q_scale = q_mu.cwiseAbs().mean();
+    ASSERT_GT(q_scale, 10.0);
+    ASSERT_GT(applied, 0);
+
+    nn::Vector random_dir(grad.size());
+    for (Eigen::Index i = 0; i < random_dir.size(); ++i) random_dir[i] = nn::uniform(rng, -1, 1);
+    for (const nn::Vector& dir :
+         {nn::Vector(grad.normalized()), nn::Vector(random_dir.normalized())}) {
+      const float eps = 1e-3f;
+      nn::Mlp plus = actor0, minus = actor0;
+      plus.params() += eps * dir;
+      minus.params() -= eps * dir;
+      auto slope = [&](const std::vector<bool>& m) {
+        return (imitation_loss(plus, critic, b, m, 0.5, q_scale) -
+                imitation_loss(minus, critic, b, m, 0.5, q_scale)) /
+               (2.0 * eps);
+      };
+      const double numeric = slope(mask);
+      const double analytic = grad.dot(dir);
+      const double tolerance = 0.02 * grad.norm();
+      EXPECT_NEAR(analytic, numeric, tolerance) << "q_filter " << q_filter;
+      // The imitation term is a real part of the gradient: leaving it out misses it.
+      if (dir.dot(grad) > 0.99f * grad.norm()) {
+        EXPECT_GT(std::abs(slope(none) - numeric), 5 * tolerance) << "q_filter " << q_filter;
+      }
+    }
+  }
+}
+
+// Without labels (or with a weight of 0) the imitation term changes nothing; with labels and
+// no Q filter, a frozen critic and a large weight, the policy moves onto the expert's actions.
+TEST(Ddpg, ImitationNeedsLabelsAndPullsThePolicyToTheExpert) {
+  DdpgConfig config = small_config(Algo::kDdpg);
+  config.critic_lr = 0.0f;
+  config.actor_lr = 1e-2f;
+  nn::Rng rng(22);
+  Batch b = random_batch(rng, 5, 2, 8, 0.0f);
+  label(b, rng, 1.0f);
+  b.expert_action.leftCols(b.size) *= 0.8f;  // inside tanh's range
+  Batch unlabelled = b;
+  unlabelled.has_expert.setZero();
+
+  DdpgConfig plain_config = config;
+  Ddpg plain(plain_config);
+  config.expert_weight = 50.0f;
+  config.expert_q_filter = false;
+  Ddpg no_labels(config), imitating(config);
+  for (int i = 0; i < 5; ++i) {
+    plain.update(b);
+    EXPECT_EQ(no_labels.update(unlabelled).expert_share, 0.0f);
+  }
+  EXPECT_EQ(no_labels.actor().params(), plain.actor().params());
+
+  const nn::Matrix x = b.state.leftCols(b.size);
+  const nn::Matrix target = b.expert_action.leftCols(b.size);
+  const double before = (eval(imitating.actor(), x) - target).norm();
+  for (int i = 0; i < 300; ++i) EXPECT_EQ(imitating.update(b).expert_share, 1.0f);
+  const double after = (eval(imitating.actor(), x) - target).norm();
+  EXPECT_LT(after, 0.2 * before) << before << " -> " << after;
 }
 
 TEST(Ddpg, UpdatesAllocateNothing) {

@@ -1,5 +1,6 @@
-// Replay buffer: ring wrap, stored fields and terminal flags, uniform seeded sampling,
-// allocation-free use, and the checkpoint record (round trip, damage rejected).
+// Replay buffer: ring wrap, stored fields (expert labels included) and terminal flags, uniform
+// seeded sampling, allocation-free use, and the checkpoint record (round trip, the version
+// before expert labels still read, damage rejected).
 #include <gtest/gtest.h>
 
 #include <sstream>
@@ -7,6 +8,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "common/nn/byte_io.hpp"
 #include "learner/replay_buffer.hpp"
 
 namespace auvrl::learner {
@@ -16,14 +18,17 @@ constexpr int kS = 3;
 constexpr int kA = 2;
 
 // Transition number i: every field derived from i so that any slot can be checked.
+// Odd transitions carry an expert label, even ones none.
 void add_numbered(ReplayBuffer& rb, int i) {
-  nn::Vector s(kS), a(kA), s1(kS);
+  nn::Vector s(kS), a(kA), s1(kS), expert(kA);
   s << i, i + 0.25f, i + 0.5f;
   a << -0.01f * i, 0.01f * i;
   s1 << i + 1, i + 1.25f, i + 1.5f;
+  expert << 0.001f * i, -0.5f;
   rb.add(TransitionView{s, a, static_cast<float>(-i), s1, i % 3 == 0,
                         Eigen::Vector3f(i, 2.0f * i, 3.0f * i), Eigen::Vector3f(7, 6, 10),
-                        static_cast<std::uint64_t>(i / 4), static_cast<std::uint32_t>(i % 4)});
+                        static_cast<std::uint64_t>(i / 4), static_cast<std::uint32_t>(i % 4),
+                        i % 2 == 1 ? expert.data() : nullptr});
 }
 
 void expect_numbered(const ReplayBuffer& rb, std::size_t slot, int i) {
@@ -37,6 +42,9 @@ void expect_numbered(const ReplayBuffer& rb, std::size_t slot, int i) {
   EXPECT_EQ(rb.goal_ned_m(slot)[2], 10.0f);
   EXPECT_EQ(rb.episode_id(slot), static_cast<std::uint64_t>(i / 4));
   EXPECT_EQ(rb.step_index(slot), static_cast<std::uint32_t>(i % 4));
+  EXPECT_EQ(rb.has_expert(slot), i % 2 == 1);
+  EXPECT_EQ(rb.expert_action(slot)[0], i % 2 == 1 ? 0.001f * i : 0.0f);
+  EXPECT_EQ(rb.expert_action(slot)[1], i % 2 == 1 ? -0.5f : 0.0f);
 }
 
 TEST(ReplayBuffer, RingWrapKeepsTheNewest) {
@@ -69,12 +77,17 @@ TEST(ReplayBuffer, SampleCopiesEveryFieldAndTheTerminalFlag) {
     EXPECT_EQ(b.reward(0, k), -3.0f);
     EXPECT_EQ(b.next_state(2, k), 4.5f);
     EXPECT_EQ(b.terminal(0, k), 1.0f);
+    EXPECT_EQ(b.has_expert(0, k), 1.0f);
+    EXPECT_EQ(b.expert_action(0, k), 0.003f);
+    EXPECT_EQ(b.expert_action(1, k), -0.5f);
     EXPECT_EQ(b.slot[static_cast<std::size_t>(k)], 0u);
   }
   ReplayBuffer rb2(kS, kA, 8);
   add_numbered(rb2, 4);  // not terminal: a time-limit cut-off is stored like this
   rb2.sample(rng, 2, b);
   EXPECT_EQ(b.terminal(0, 0), 0.0f);
+  EXPECT_EQ(b.has_expert(0, 0), 0.0f);  // no label: flag and label cleared
+  EXPECT_EQ(b.expert_action(1, 0), 0.0f);
   EXPECT_EQ(b.size, 2);
 }
 
@@ -201,6 +214,58 @@ TEST(ReplayBuffer, DamagedOrMismatchedRecordsAreRejectedAndTheBufferKept) {
     EXPECT_NE(std::string(e.what()).find("expected state_dim 4"), std::string::npos) << e.what();
   }
   EXPECT_THROW(other_capacity.restore(is2), std::runtime_error);
+}
+
+// Checkpoints written before expert labels existed (version 1) still restore, as transitions
+// without labels.
+TEST(ReplayBuffer, VersionOneRecordsRestoreWithoutLabels) {
+  std::stringstream ss;
+  {
+    nn::OStreamSink sink(ss);
+    nn::Writer w(sink);
+    const char magic[8] = {'A', 'U', 'V', 'R', 'L', 'R', 'B', '\0'};
+    w.bytes(magic, sizeof magic);
+    w.u32(1);
+    w.u32(kS);
+    w.u32(kA);
+    w.u64(4);  // capacity
+    w.u64(2);  // size
+    w.u64(2);  // next slot
+    w.u64(2);  // total added
+    const float states[2 * kS] = {1, 1.25f, 1.5f, 2, 2.25f, 2.5f};
+    const float actions[2 * kA] = {-0.01f, 0.01f, -0.02f, 0.02f};
+    const float rewards[2] = {-1, -2};
+    const float next_states[2 * kS] = {2, 2.25f, 2.5f, 3, 3.25f, 3.5f};
+    const std::uint8_t terminal[2] = {0, 0};
+    const float achieved[6] = {1, 2, 3, 2, 4, 6};
+    const float goals[6] = {7, 6, 10, 7, 6, 10};
+    const std::uint64_t episodes[2] = {0, 0};
+    const std::uint32_t steps[2] = {1, 2};
+    w.f32_array(states, 2 * kS);
+    w.f32_array(actions, 2 * kA);
+    w.f32_array(rewards, 2);
+    w.f32_array(next_states, 2 * kS);
+    w.bytes(terminal, 2);
+    w.f32_array(achieved, 6);
+    w.f32_array(goals, 6);
+    w.u64_array(episodes, 2);
+    w.u32_array(steps, 2);
+    w.checksum();
+  }
+  ReplayBuffer rb(kS, kA, 4);
+  add_numbered(rb, 7);  // a label in slot 0 that must not survive the restore
+  rb.restore(ss);
+  ASSERT_EQ(rb.size(), 2u);
+  for (std::size_t slot : {std::size_t{0}, std::size_t{1}}) {
+    const float i = static_cast<float>(slot) + 1;
+    EXPECT_EQ(rb.state(slot)[2], i + 0.5f);
+    EXPECT_EQ(rb.action(slot)[1], 0.01f * i);
+    EXPECT_EQ(rb.next_state(slot)[1], i + 1.25f);
+    EXPECT_EQ(rb.achieved_position_ned_m(slot)[2], 3 * i);
+    EXPECT_EQ(rb.step_index(slot), slot + 1);
+    EXPECT_FALSE(rb.has_expert(slot));
+    EXPECT_EQ(rb.expert_action(slot)[0], 0.0f);
+  }
 }
 
 }  // namespace
