@@ -170,7 +170,7 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
     msg.state_dim = state_dim;
     msg.action_dim = action_dim;
     msg.num_transitions = static_cast<std::int32_t>(end - begin);
-    msg.expert_action_dim = config_.expert ? action_dim : 0;
+    msg.expert_rows = config_.expert ? msg.num_transitions : 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Transition& t = transitions[i];
       msg.states.emplace_back(t.state.data(), t.state.data() + state_dim);

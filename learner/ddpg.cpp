@@ -65,6 +65,10 @@ void DdpgConfig::validate() const {
   if (!(expert_weight >= 0.0f) || !std::isfinite(expert_weight)) {
     bad("expert_weight must be finite and >= 0");
   }
+  if (!(expert_weight_half_life_updates >= 0.0) ||
+      !std::isfinite(expert_weight_half_life_updates)) {
+    bad("expert_weight_half_life_updates must be finite and >= 0");
+  }
   actor_spec(*this).validate();
   critic_spec(*this).validate();
 }
@@ -180,7 +184,7 @@ UpdateStats Ddpg::update(const Batch& b) {
 void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
   const Eigen::Index n = b.size;
   const auto x = b.state.leftCols(n);
-  const bool imitate = config_.expert_weight > 0.0f && b.has_expert.leftCols(n).sum() > 0.0f;
+  const bool imitate = expert_weight() > 0.0f && b.has_expert.leftCols(n).sum() > 0.0f;
   auto q_expert = q_expert_.leftCols(n);
   if (imitate && config_.expert_q_filter) {
     // Before the policy's own forward pass: the backward pass needs that one's activations.
@@ -196,8 +200,8 @@ void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
   dmu = critics_[0].extra_input_grad();
   last_expert_share_ = 0.0f;
   if (imitate) {
-    const float c = 2.0f * config_.expert_weight * q.cwiseAbs().mean() /
-                    static_cast<float>(n * config_.action_dim);
+    const float c =
+        2.0f * expert_weight() * q.cwiseAbs().mean() / static_cast<float>(n * config_.action_dim);
     int applied = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const bool use =
@@ -212,6 +216,13 @@ void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
   stats.actor_grad_norm = actor_opt_.step(actor_);
   stats.actor_updated = true;
   ++actor_updates_;
+}
+
+float Ddpg::expert_weight() const {
+  if (config_.expert_weight_half_life_updates <= 0.0) return config_.expert_weight;
+  return config_.expert_weight *
+         static_cast<float>(
+             std::exp2(-static_cast<double>(updates_) / config_.expert_weight_half_life_updates));
 }
 
 Eigen::Block<const nn::Matrix> Ddpg::act(const nn::ConstMatrixRef& states) {

@@ -70,6 +70,8 @@ struct DdpgConfig {
   /// independent of the reward's scale, as in TD3+BC (Fujimoto and Gu 2021; its alpha = 2.5
   /// is a weight of 0.4 here). 0: off.
   float expert_weight = 0.0f;
+  /// The weight halves every this many updates (a guide early, RL alone later); 0: constant.
+  double expert_weight_half_life_updates = 0.0;
   /// Apply the imitation term only where the critic prefers the expert's action (the Q
   /// filter); false: wherever there is a label.
   bool expert_q_filter = true;
@@ -118,6 +120,8 @@ class Ddpg {
     return critic_targets_[static_cast<std::size_t>(i)];
   }
   int num_critics() const { return static_cast<int>(critics_.size()); }
+  /// The imitation weight now: expert_weight, halved every expert_weight_half_life_updates.
+  float expert_weight() const;
   /// Updates done (critic steps).
   std::int64_t updates() const { return updates_; }
   /// Actor steps done (fewer than updates() with TD3's delay).

@@ -33,6 +33,7 @@ void read_learner_section(config::Section s, LearnerNodeConfig& c) {
   s.read("td3_policy_delay", d.td3_policy_delay);
   s.read("expert_weight", d.expert_weight);
   s.read("expert_q_filter", d.expert_q_filter);
+  s.read("expert_weight_half_life_updates", d.expert_weight_half_life_updates);
   s.read("seed", d.seed);
   s.read("updates_per_transition", c.updates_per_transition);
   s.read("warmup_transitions", c.warmup_transitions);

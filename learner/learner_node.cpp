@@ -117,8 +117,7 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
       n < 1 || n > config_.max_transitions_per_batch || !rows_ok(msg.states, msg.state_dim) ||
       !rows_ok(msg.next_states, msg.state_dim) || !rows_ok(msg.actions, msg.action_dim) ||
       !rows_ok(msg.achieved_position_ned_m, 3) || !rows_ok(msg.goal_ned_m, 3) ||
-      (msg.expert_action_dim != 0 && msg.expert_action_dim != msg.action_dim) ||
-      (msg.expert_action_dim != 0 && !rows_ok(msg.expert_actions, msg.expert_action_dim))) {
+      (msg.expert_rows != 0 && !rows_ok(msg.expert_actions, msg.action_dim))) {
     ++counters_.dropped_dims;
     return;
   }
@@ -161,8 +160,7 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
             (static_cast<std::uint64_t>(msg.episode_id[static_cast<std::size_t>(i)]) &
              ((std::uint64_t{1} << 40) - 1)),
         static_cast<std::uint32_t>(msg.step_index[static_cast<std::size_t>(i)]),
-        msg.expert_action_dim != 0 ? msg.expert_actions[static_cast<std::size_t>(i)].data()
-                                   : nullptr};
+        msg.expert_rows != 0 ? msg.expert_actions[static_cast<std::size_t>(i)].data() : nullptr};
     const std::size_t slot = replay_->next_slot();
     const bool overwrote = replay_->size() == replay_->capacity();
     const std::uint64_t overwritten_episode = overwrote ? replay_->episode_id(slot) : 0;

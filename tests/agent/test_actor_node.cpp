@@ -1,7 +1,8 @@
-// The actor's demonstrations, in process: auv_sim's server and the actor on one in-process bus
-// (the server answers inside the actor's own lockstep waits), no learner (the policy is zero
-// until weights arrive). A demonstration is driven by the demonstrator, its experience goes
-// out like any other and it is not reported as an episode.
+// The actor's demonstrations and expert labels, in process: auv_sim's server and the actor on
+// one in-process bus (the server answers inside the actor's own lockstep waits), no learner (the
+// policy is zero until weights arrive). A demonstration is driven by the demonstrator, its
+// experience goes out like any other and it is not reported as an episode; expert labels are
+// the expert's command in each transition's state.
 #include <gtest/gtest.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
@@ -11,6 +12,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "agent/actor_config.hpp"
 #include "agent/actor_node.hpp"
@@ -36,6 +38,7 @@ class ActorDemonstrations : public ::testing::Test {
         *bus_, channels::kExperience,
         [this](const std::string&, const auvrl_lcm::experience_batch_t& m) {
           transitions_ += m.num_transitions;
+          batches_.push_back(m);
         });
   }
   static sim::SimServerConfig server_config() {
@@ -64,6 +67,7 @@ class ActorDemonstrations : public ::testing::Test {
   std::ostringstream log_;
   int reports_ = 0;
   std::int64_t transitions_ = 0;
+  std::vector<auvrl_lcm::experience_batch_t> batches_;
 };
 
 TEST_F(ActorDemonstrations, AllDemonstrationsReachAndSendExperienceButNoReports) {
@@ -115,17 +119,59 @@ TEST_F(ActorDemonstrations, AFractionWithoutADemonstratorIsAnError) {
   EXPECT_THROW(ActorNode(c, *bus_, log_), std::invalid_argument);
 }
 
-TEST(ActorConfigFile, ReadsTheDemonstrationFractionAndTheVehicle) {
+// Expert labels: a second PID, asked in every state but never driving. With the PID also
+// driving (demonstrations, no noise) each label must equal the action taken in that state:
+// labels belong to x_t (not x_t+1) and the expert restarts with every episode.
+TEST_F(ActorDemonstrations, ExpertLabelsAreThePidsCommandInEachState) {
+  ActorNodeConfig c = config(1.0);
+  c.expert_labels = true;
+  c.expert = std::make_shared<PidController>(model_);
+  ActorNode node(c, *bus_, log_);
+  for (int i = 0; i < 3; ++i) node.run_one_episode();
+  bus_->drain();
+  ASSERT_FALSE(batches_.empty());
+  std::int64_t labels = 0;
+  for (const auto& m : batches_) {
+    ASSERT_EQ(m.expert_rows, m.num_transitions);
+    ASSERT_EQ(static_cast<int>(m.expert_actions.size()), m.num_transitions);
+    for (int i = 0; i < m.num_transitions; ++i) {
+      for (int j = 0; j < m.action_dim; ++j) {
+        ASSERT_EQ(m.expert_actions[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)],
+                  m.actions[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)])
+            << "step " << m.step_index[static_cast<std::size_t>(i)] << " thruster " << j;
+      }
+      ++labels;
+    }
+  }
+  EXPECT_EQ(labels, transitions_);
+
+  // Off: no labels in the messages. On without an expert: an error.
+  batches_.clear();
+  ActorNode plain(config(0.0), *bus_, log_);
+  plain.run_one_episode();
+  bus_->drain();
+  ASSERT_FALSE(batches_.empty());
+  for (const auto& m : batches_) {
+    EXPECT_EQ(m.expert_rows, 0);
+    EXPECT_TRUE(m.expert_actions.empty());
+  }
+  ActorNodeConfig no_expert = config(0.0);
+  no_expert.expert_labels = true;
+  EXPECT_THROW(ActorNode(no_expert, *bus_, log_), std::invalid_argument);
+}
+
+TEST(ActorConfigFile, ReadsDemonstrationsExpertLabelsAndTheVehicle) {
   const std::string path = testing::TempDir() + "actor_demonstrations.yaml";
   const auto write = [&](const std::string& fraction) {
     std::ofstream(path) << "vehicle: ../vehicles/nessie7.yaml\nactor:\n  demonstration_fraction: "
-                        << fraction << "\n";
+                        << fraction << "\n  expert_labels: true\n";
   };
   write("0.25");
   ActorNodeConfig c;
   std::string vehicle;
   read_actor_config_file(path, c, &vehicle);
   EXPECT_DOUBLE_EQ(c.demonstration_fraction, 0.25);
+  EXPECT_TRUE(c.expert_labels);
   // Resolved against the run file's folder, as the launcher does.
   EXPECT_NE(vehicle.find("vehicles/nessie7.yaml"), std::string::npos);
   EXPECT_NE(vehicle, "../vehicles/nessie7.yaml");

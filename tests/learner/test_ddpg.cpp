@@ -81,6 +81,12 @@ TEST(DdpgConfig, DefaultsAreLillicrapsAndValidated) {
   d.validate();
   d.tau = 0;
   EXPECT_THROW(d.validate(), std::invalid_argument);
+  EXPECT_EQ(c.expert_weight, 0.0f);  // imitation is an addition of ours: off by default
+  d = small_config(Algo::kDdpg);
+  d.expert_weight = -0.1f;
+  EXPECT_THROW(d.validate(), std::invalid_argument);
+  d.expert_weight = std::nanf("");
+  EXPECT_THROW(d.validate(), std::invalid_argument);
   EXPECT_EQ(parse_algo("td3"), Algo::kTd3);
   EXPECT_THROW(parse_algo("sac"), std::invalid_argument);
 }
@@ -336,6 +342,28 @@ TEST(Ddpg, ImitationNeedsLabelsAndPullsThePolicyToTheExpert) {
   for (int i = 0; i < 300; ++i) EXPECT_EQ(imitating.update(b).expert_share, 1.0f);
   const double after = (eval(imitating.actor(), x) - target).norm();
   EXPECT_LT(after, 0.2 * before) << before << " -> " << after;
+}
+
+// The imitation weight halves every expert_weight_half_life_updates updates (0: constant).
+TEST(Ddpg, ImitationWeightHalvesEveryHalfLife) {
+  DdpgConfig config = small_config(Algo::kTd3);
+  config.expert_weight = 0.8f;
+  Ddpg constant(config);
+  config.expert_weight_half_life_updates = 4;
+  Ddpg halving(config);
+  nn::Rng rng(23);
+  const Batch b = random_batch(rng, 5, 2, 8, 0.1f);
+  EXPECT_FLOAT_EQ(halving.expert_weight(), 0.8f);
+  for (int i = 0; i < 8; ++i) {
+    halving.update(b);
+    constant.update(b);
+  }
+  EXPECT_FLOAT_EQ(halving.expert_weight(), 0.2f);
+  halving.update(b);
+  EXPECT_FLOAT_EQ(halving.expert_weight(), 0.8f * std::exp2(-9.0f / 4.0f));
+  EXPECT_FLOAT_EQ(constant.expert_weight(), 0.8f);
+  config.expert_weight_half_life_updates = -1;
+  EXPECT_THROW(config.validate(), std::invalid_argument);
 }
 
 TEST(Ddpg, UpdatesAllocateNothing) {

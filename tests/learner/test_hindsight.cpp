@@ -45,6 +45,7 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
   learner::HindsightRelabeler her(cfg, 4);
   task::StateVector s, s2;
   task::ActionVector prev = task::ActionVector::Zero(6);
+  const task::ActionVector expert = task::ActionVector::Constant(6, 0.25f);  // every step labelled
   for (int t = 0; t < n; ++t) {
     task::build_state(cfg, steps[t].obs, goal, prev, s);
     task::build_state(cfg, steps[t + 1].obs, goal, steps[t].action, s2);
@@ -59,7 +60,8 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
                                        steps[t + 1].obs.position_ned_m.cast<float>(),
                                        goal.cast<float>(),
                                        7,
-                                       static_cast<std::uint32_t>(t)};
+                                       static_cast<std::uint32_t>(t),
+                                       expert.data()};
     const std::size_t slot = replay.next_slot();
     replay.add(view);
     her.on_add(replay, slot, false, 0);
@@ -76,7 +78,12 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
     for (int i = 0; i < batch.size; ++i) {
       const std::size_t slot = batch.slot[static_cast<std::size_t>(i)];
       const int t = static_cast<int>(replay.step_index(slot));
-      if ((batch.state.col(i) - original.state.col(i)).norm() == 0.0f) continue;  // not chosen
+      if ((batch.state.col(i) - original.state.col(i)).norm() == 0.0f) {
+        EXPECT_EQ(batch.has_expert(0, i), 1.0f);  // not chosen: the label still holds
+        continue;
+      }
+      // The expert's label was for the old goal: it goes with it.
+      EXPECT_EQ(batch.has_expert(0, i), 0.0f);
       // Which goal was used? One of the later achieved positions: find it.
       bool matched = false;
       for (int f = t; f < n && !matched; ++f) {

@@ -1,7 +1,8 @@
 // auv_learner's handling of hostile messages with a valid LCM encoding, in-process (memq):
-// experience with wrong dimensions, NaN/inf, actions beyond the tanh range, too many or no
-// transitions, unknown actor ids, and episode reports from unknown actors are dropped and
-// counted; nothing of them reaches the replay buffer, the updates or the schedule.
+// experience with wrong dimensions, NaN/inf, actions or expert labels beyond [-1, 1], malformed
+// expert labels, too many or no transitions, unknown actor ids, and episode reports from unknown
+// actors are dropped and counted; nothing of them reaches the replay buffer, the updates or the
+// schedule.
 #include <gtest/gtest.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
@@ -95,6 +96,43 @@ TEST_F(LearnerNodeInput, NonFiniteValuesAnywhereAreDropped) {
   send(channels::kExperience, b);
   EXPECT_EQ(node_->counters().dropped_non_finite, 7);
   expect_untouched();
+}
+
+// Expert labels: none or one per transition of action_dim values in [-1, 1]; anything else is
+// dropped whole, and good labels reach the replay buffer with the transitions.
+TEST_F(LearnerNodeInput, ExpertLabelsAreCheckedAndStored) {
+  const int ad = config_.ddpg.action_dim;
+  const auto labelled = [&](int n) {
+    auto b = batch(n);
+    b.expert_rows = n;
+    b.expert_actions.assign(static_cast<std::size_t>(n), std::vector<float>(ad, -0.5f));
+    return b;
+  };
+  auto b = labelled(5);
+  b.expert_rows = 4;  // neither 0 nor num_transitions
+  b.expert_actions.pop_back();
+  send(channels::kExperience, b);
+  b = labelled(5);
+  b.expert_rows = 6;
+  b.expert_actions.push_back(b.expert_actions.back());
+  send(channels::kExperience, b);
+  EXPECT_EQ(node_->counters().dropped_dims, 2);
+  b = labelled(5);
+  b.expert_actions[2][1] = std::nanf("");
+  send(channels::kExperience, b);
+  b = labelled(5);
+  b.expert_actions[4][0] = -1.5f;  // beyond [-1, 1]
+  send(channels::kExperience, b);
+  EXPECT_EQ(node_->counters().dropped_non_finite, 2);
+  expect_untouched();
+
+  send(channels::kExperience, labelled(3));
+  send(channels::kExperience, batch(2));  // no labels
+  ASSERT_EQ(node_->replay().size(), 5u);
+  for (std::size_t slot = 0; slot < 5; ++slot) {
+    EXPECT_EQ(node_->replay().has_expert(slot), slot < 3) << slot;
+    EXPECT_EQ(node_->replay().expert_action(slot)[ad - 1], slot < 3 ? -0.5f : 0.0f) << slot;
+  }
 }
 
 TEST_F(LearnerNodeInput, UnknownActorsAreDroppedAndDoNotAdvanceTheSchedule) {
