@@ -1,6 +1,5 @@
 #include "learner/replay_buffer.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -196,8 +195,7 @@ void ReplayBuffer::restore(nn::Reader& r) {
     r.bytes(fresh.has_expert_.data(), n);
     r.f32_array(fresh.expert_actions_.data(), n * action_dim);
   } else {
-    std::fill(fresh.has_expert_.begin(), fresh.has_expert_.begin() + static_cast<std::ptrdiff_t>(n),
-              std::uint8_t{0});
+    // The flags are already 0 (a fresh vector); the labels' storage is not initialised.
     fresh.expert_actions_.leftCols(static_cast<Eigen::Index>(n)).setZero();
   }
   r.verify_checksum();
