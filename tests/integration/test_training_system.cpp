@@ -69,7 +69,10 @@ TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
 
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(40);
   const auto enough = [&] {
-    if (stats.empty() || stats.back().buffer_size < 5000 || stats.back().updates < 500) {
+    // The learner's own episode count too: its stats come once a second and, over DDS, the
+    // first reports can precede discovery, so its count trails the actors' reports.
+    if (stats.empty() || stats.back().buffer_size < 5000 || stats.back().updates < 500 ||
+        stats.back().episodes < 60) {
       return false;
     }
     for (int id = 0; id < 2; ++id) {
