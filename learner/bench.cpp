@@ -33,15 +33,25 @@ class ThreadScope {
   int saved_;
 };
 
-void fill_random(ReplayBuffer& replay, nn::Rng& rng) {
-  nn::Vector s(replay.state_dim()), s1(replay.state_dim()), a(replay.action_dim());
+void fill_random(ReplayBuffer& replay, nn::Rng& rng, bool expert_labels) {
+  nn::Vector s(replay.state_dim()), s1(replay.state_dim()), a(replay.action_dim()),
+      expert(replay.action_dim());
   for (std::size_t i = 0; i < replay.capacity(); ++i) {
     for (Eigen::Index k = 0; k < s.size(); ++k) s[k] = nn::uniform(rng, -1.0f, 1.0f);
     for (Eigen::Index k = 0; k < s1.size(); ++k) s1[k] = nn::uniform(rng, -1.0f, 1.0f);
     for (Eigen::Index k = 0; k < a.size(); ++k) a[k] = nn::uniform(rng, -1.0f, 1.0f);
-    replay.add(TransitionView{s, a, nn::uniform(rng, -1.0f, 0.0f), s1, (i % 97) == 0,
-                              Eigen::Vector3f::Zero(), Eigen::Vector3f::Zero(), i / 700,
-                              static_cast<std::uint32_t>(i % 700)});
+    for (Eigen::Index k = 0; k < expert.size(); ++k) expert[k] = nn::uniform(rng, -1.0f, 1.0f);
+    TransitionView t{s,
+                     a,
+                     nn::uniform(rng, -1.0f, 0.0f),
+                     s1,
+                     (i % 97) == 0,
+                     Eigen::Vector3f::Zero(),
+                     Eigen::Vector3f::Zero(),
+                     i / 700,
+                     static_cast<std::uint32_t>(i % 700)};
+    if (expert_labels) t.expert_action = expert.data();
+    replay.add(t);
   }
 }
 
@@ -57,10 +67,11 @@ BenchResult run_update_benchmark(const BenchCase& c) {
   config.critic_hidden = c.hidden;
   config.critic_action_layer = c.algo == Algo::kTd3 ? 0 : 1;
   config.batch_size = c.batch;
+  config.expert_weight = c.expert_weight;
   Ddpg learner(config);
   nn::Rng rng(12345);
   ReplayBuffer replay(c.state_dim, c.action_dim, kReplaySize);
-  fill_random(replay, rng);
+  fill_random(replay, rng, c.expert_weight > 0.0f);
 
   using Clock = std::chrono::steady_clock;
   // Warm-up: caches, page faults of the workspaces, CPU frequency.
@@ -109,6 +120,16 @@ std::vector<BenchCase> standard_bench_cases(Algo algo) {
   return cases;
 }
 
+BenchCase fast_preset_bench_case(float expert_weight) {
+  BenchCase c;
+  c.algo = Algo::kTd3;
+  c.hidden = {64, 64};
+  c.batch = 64;
+  c.state_dim = 29;
+  c.expert_weight = expert_weight;
+  return c;
+}
+
 std::string format_bench_line(const BenchResult& r) {
   std::ostringstream os;
   os << "algo=" << to_string(r.config.algo) << " hidden=";
@@ -120,6 +141,7 @@ std::string format_bench_line(const BenchResult& r) {
   if (r.config.state_dim != 23 || r.config.action_dim != 6) {
     os << " state_dim=" << r.config.state_dim << " action_dim=" << r.config.action_dim;
   }
+  if (r.config.expert_weight > 0.0f) os << " expert_weight=" << r.config.expert_weight;
   return os.str();
 }
 

@@ -25,6 +25,9 @@ struct BenchCase {
   int state_dim = 23;
   int action_dim = 6;
   double seconds = 2.0;  ///< measuring time, after a short warm-up
+  /// Q-filtered imitation (DdpgConfig::expert_weight): > 0 labels every transition with an
+  /// expert action and adds the imitation term (and its Q filter) to each actor step.
+  float expert_weight = 0.0f;
 };
 
 /// What a case measured.
@@ -50,8 +53,13 @@ BenchResult run_update_benchmark(Algo algo, const std::vector<int>& hidden, int 
 /// 400-300 batch 64.
 std::vector<BenchCase> standard_bench_cases(Algo algo);
 
+/// The fast preset's learner: TD3, 64-64, batch 64, the extended state with the realised thrust
+/// (29 values), one thread, with the preset's imitation weight (0.4) or without it (0).
+BenchCase fast_preset_bench_case(float expert_weight);
+
 /// "algo=ddpg hidden=256-256 batch=256 threads=1 updates_per_s=N"; for dims other than the AUV
-/// task's (23, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken.
+/// task's (23, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken, and
+/// " expert_weight=W" with imitation.
 std::string format_bench_line(const BenchResult& r);
 /// Writes format_bench_line(r) and a newline.
 void print_bench_line(std::ostream& os, const BenchResult& r);

@@ -1,5 +1,7 @@
 // Prints the learner's update rates: the three standard cases (AUV dims 23/6, one thread), for
-// DDPG and TD3, and the same with pendulum dims (state 3, action 1), as RLtools reports them.
+// DDPG and TD3, and the same with pendulum dims (state 3, action 1), as RLtools reports them;
+// then the fast preset's learner without and with the PID imitation term, alternated three
+// times (the machine is shared), and the ratio of their rates.
 // Usage: bench_updates [seconds per case]. Not a CTest test.
 #include <cstdlib>
 #include <iostream>
@@ -33,5 +35,20 @@ int main(int argc, char** argv) {
       }
     }
   }
+  // The imitation term's cost: the same case without and with it, interleaved so that both see
+  // the same load; the ratio of the sums is what to compare across machines.
+  double plain_updates = 0, plain_s = 0, imitation_updates = 0, imitation_s = 0;
+  for (int round = 0; round < 3; ++round) {
+    for (float weight : {0.0f, 0.4f}) {
+      BenchCase c = fast_preset_bench_case(weight);
+      c.seconds = seconds;
+      const BenchResult r = run_update_benchmark(c);
+      print_bench_line(std::cout, r);
+      (weight > 0.0f ? imitation_updates : plain_updates) += static_cast<double>(r.updates);
+      (weight > 0.0f ? imitation_s : plain_s) += r.seconds;
+    }
+  }
+  std::cout << "fast preset: updates/s with imitation / without = "
+            << (imitation_updates / imitation_s) / (plain_updates / plain_s) << '\n';
   return 0;
 }

@@ -483,5 +483,20 @@ TEST(Bench, LineFormatAndParsing) {
   EXPECT_GT(quick.updates_per_s, 0);
 }
 
+TEST(Bench, TheFastPresetCaseWithImitationRunsAndSaysSo) {
+  BenchCase c = fast_preset_bench_case(0.4f);
+  EXPECT_EQ(c.algo, Algo::kTd3);
+  EXPECT_EQ(c.hidden, (std::vector<int>{64, 64}));
+  EXPECT_EQ(c.state_dim, 29);
+  c.seconds = 0.05;
+  const BenchResult r = run_update_benchmark(c);
+  EXPECT_GT(r.updates, 0);
+  EXPECT_NE(format_bench_line(r).find(" expert_weight=0.4"), std::string::npos)
+      << format_bench_line(r);
+  BenchCase plain = fast_preset_bench_case(0.0f);
+  plain.seconds = 0.05;
+  EXPECT_EQ(format_bench_line(run_update_benchmark(plain)).find("expert"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace auvrl::learner
