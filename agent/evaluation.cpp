@@ -1,5 +1,6 @@
 #include "agent/evaluation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -227,6 +228,54 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
   }
   if (!out_dir.empty()) write_summary_csv((dir / "summary.csv").string(), rows);
   return rows;
+}
+
+bool ValidationScore::better_than(const ValidationScore& other, double max_hold_m) const {
+  if (reached != other.reached) return reached > other.reached;
+  const bool holds = mean_hold_m <= max_hold_m;
+  const bool other_holds = other.mean_hold_m <= max_hold_m;
+  if (holds != other_holds) return holds;
+  if (!holds) return mean_hold_m < other.mean_hold_m;
+  if (max_time_ratio != other.max_time_ratio) return max_time_ratio < other.max_time_ratio;
+  return mean_time_s < other.mean_time_s;
+}
+
+ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
+                                        const std::vector<SummaryRow>& reference) {
+  if (rows.size() != reference.size()) {
+    throw std::invalid_argument("validation score: " + std::to_string(rows.size()) +
+                                " episodes against " + std::to_string(reference.size()) +
+                                " of the reference; expected the same episodes");
+  }
+  ValidationScore score;
+  double time_sum = 0, hold_sum = 0, worst_ratio = 0;
+  bool any_ratio = false;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const SummaryRow& r = rows[i];
+    const SummaryRow& ref = reference[i];
+    if (r.scenario != ref.scenario || r.episode != ref.episode ||
+        !r.goal_ned_m.isApprox(ref.goal_ned_m)) {
+      throw std::invalid_argument("validation score: episode " + std::to_string(i) + " (" +
+                                  r.scenario + " " + std::to_string(r.episode) +
+                                  ") is not the reference's (" + ref.scenario + " " +
+                                  std::to_string(ref.episode) + ")");
+    }
+    ++score.episodes;
+    if (!r.reached) continue;
+    ++score.reached;
+    time_sum += r.time_to_reach_s;
+    hold_sum += r.mean_error_after_reach_m;
+    if (ref.reached && ref.time_to_reach_s > 0.0) {
+      worst_ratio = std::max(worst_ratio, r.time_to_reach_s / ref.time_to_reach_s);
+      any_ratio = true;
+    }
+  }
+  if (score.reached > 0) {
+    score.mean_time_s = time_sum / score.reached;
+    score.mean_hold_m = hold_sum / score.reached;
+  }
+  if (any_ratio) score.max_time_ratio = worst_ratio;
+  return score;
 }
 
 std::string summary_csv_header() {

@@ -113,6 +113,29 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
                                        const std::vector<Scenario>& scenarios,
                                        const std::string& out_dir);
 
+/// How a candidate policy did on validation way-points, against a reference controller (the
+/// PID baseline) on the same way-points: what `auvrl train` keeps its best policy by.
+struct ValidationScore {
+  int reached = 0;
+  int episodes = 0;
+  double mean_time_s = 1e9;  ///< mean time to reach over the reached way-points
+  double mean_hold_m = 1e9;  ///< mean hold error over the reached way-points
+  /// Worst ratio of the candidate's time to reach to the reference's, over the way-points both
+  /// reached (1e9: none): below 1, it reached every way-point sooner than the reference.
+  double max_time_ratio = 1e9;
+
+  /// Ranks: more way-points reached; then a mean hold error within max_hold_m (or, both
+  /// outside, the smaller); then the smaller worst ratio; then the shorter mean time. The worst
+  /// ratio rather than the mean time, because the evaluation compares the policy with the PID
+  /// scenario by scenario (a policy much faster on most way-points can still lose on one).
+  bool better_than(const ValidationScore& other, double max_hold_m) const;
+};
+
+/// Scores `rows` (the candidate's) against `reference` (the same episodes, in the same order,
+/// run by the reference controller); throws std::invalid_argument if they do not match.
+ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
+                                        const std::vector<SummaryRow>& reference);
+
 /// Header line of summary.csv (no newline).
 std::string summary_csv_header();
 /// Writes summary.csv; throws std::runtime_error naming the path on failure.

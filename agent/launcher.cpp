@@ -24,6 +24,7 @@
 #include <sstream>
 
 #include "agent/evaluation.hpp"
+#include "agent/pid_controller.hpp"
 #include "common/channels.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/nn/file_io.hpp"
@@ -66,6 +67,10 @@ RunConfig read_run_config(const std::string& path) {
   run.read("max_train_s", c.run.max_train_s);
   run.read("best_eval_period_s", c.run.best_eval_period_s);
   run.read("best_eval_suite", c.run.best_eval_suite);
+  run.read("best_eval_max_hold_m", c.run.best_eval_max_hold_m);
+  if (!(c.run.best_eval_max_hold_m > 0.0)) {
+    run.fail("best_eval_max_hold_m", "expected a hold error in metres greater than 0");
+  }
   run.read("learner_cpu", c.run.learner_cpu);
   run.read("private_lockstep_bus", c.run.private_lockstep_bus);
   run.read("max_restarts", c.run.max_restarts);
@@ -104,45 +109,35 @@ struct Role {
 /// Seed of the quick evaluation's way-points (the reported suite uses seed 1).
 constexpr std::uint64_t kValidationSeed = 0x7A11DA7E;
 
-/// A quick score of a policy: reached count first, then faster and closer holding.
-struct QuickScore {
-  int reached = 0;
-  int episodes = 0;
-  double mean_time_s = 1e9;
-  double mean_hold_m = 1e9;
-  bool better_than(const QuickScore& o) const {
-    if (reached != o.reached) return reached > o.reached;
-    return mean_time_s + 10.0 * mean_hold_m < o.mean_time_s + 10.0 * o.mean_hold_m;
+/// The quick evaluation that keeps the best policy: the validation way-points, run once by the
+/// PID baseline at construction and by each candidate policy on demand.
+class QuickEvaluator {
+ public:
+  QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task, int suite_episodes)
+      : model_(model), task_(task) {
+    config_.task = task;
+    config_.suite_episodes = suite_episodes;
+    config_.suite_trajectories = 0;
+    // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
+    // and the suite's seed 1) must not be the ones that choose the policy, or the reported
+    // times would be the best of many draws on the very tests.
+    config_.seed = kValidationSeed;
+    PidController pid(model_);
+    reference_ = run_evaluation(model_, config_, pid, {Scenario::kSuite}, "");
   }
-};
 
-QuickScore quick_evaluate(const sim::VehicleModel& model, const task::TaskConfig& task,
-                          const nn::Mlp& network, int suite_episodes) {
-  EvaluationConfig config;
-  config.task = task;
-  config.suite_episodes = suite_episodes;
-  config.suite_trajectories = 0;
-  // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
-  // and the suite's seed 1) must not be the ones that choose the policy, or the reported
-  // times would be the best of many draws on the very tests.
-  config.seed = kValidationSeed;
-  PolicyController controller(network, task.state_dim(), task.num_thrusters);
-  const auto rows = run_evaluation(model, config, controller, {Scenario::kSuite}, "");
-  QuickScore s;
-  double time_sum = 0, hold_sum = 0;
-  for (const SummaryRow& r : rows) {
-    ++s.episodes;
-    if (!r.reached) continue;
-    ++s.reached;
-    time_sum += r.time_to_reach_s;
-    hold_sum += r.mean_error_after_reach_m;
+  ValidationScore evaluate(const nn::Mlp& network) const {
+    PolicyController controller(network, task_.state_dim(), task_.num_thrusters);
+    return score_against_reference(
+        run_evaluation(model_, config_, controller, {Scenario::kSuite}, ""), reference_);
   }
-  if (s.reached > 0) {
-    s.mean_time_s = time_sum / s.reached;
-    s.mean_hold_m = hold_sum / s.reached;
-  }
-  return s;
-}
+
+ private:
+  const sim::VehicleModel& model_;
+  task::TaskConfig task_;
+  EvaluationConfig config_;
+  std::vector<SummaryRow> reference_;
+};
 
 /// Whether dir holds a finished learner checkpoint (checkpoint-<updates>.ckpt). A learner
 /// killed while writing leaves only its temporary file, which --resume cannot use.
@@ -211,7 +206,8 @@ std::string prepare_run_directory(TrainOptions& o) {
         << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
         << "  checkpoints/      learner checkpoints (auvrl train --resume " << o.run_dir << ")\n"
         << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
-        << "  quick_eval.csv    every quick evaluation (reached, mean time, hold error, kept)\n"
+        << "  quick_eval.csv    every quick evaluation (reached, mean time, hold error, worst\n"
+           "                    time ratio to the PID's on the same way-points, kept)\n"
         << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"
         << "  processes/        each process's output\n"
         << "Watch the running system with lcm-spy: scripts/spy.sh " << o.run_dir << "\n";
@@ -262,12 +258,22 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   std::ofstream episodes_csv(run_dir / "episodes.csv", std::ios::app);
   std::ofstream learner_csv(run_dir / "learner.csv", std::ios::app);
   std::ofstream progress_csv(run_dir / "progress.csv", std::ios::app);
+  const std::string quick_eval_header =
+      "wall_s,policy_version,reached,episodes,mean_time_to_reach_s,mean_error_after_reach_m,"
+      "max_time_ratio_to_pid,kept";
+  if (fs::exists(run_dir / "quick_eval.csv")) {
+    // A run resumed from an older version whose columns differ: keep its rows apart rather
+    // than append rows that do not match the header.
+    std::ifstream existing(run_dir / "quick_eval.csv");
+    std::string header;
+    std::getline(existing, header);
+    if (header != quick_eval_header) {
+      fs::rename(run_dir / "quick_eval.csv", run_dir / "quick_eval.old.csv");
+    }
+  }
   const bool new_quick_eval = !fs::exists(run_dir / "quick_eval.csv");
   std::ofstream quick_eval_csv(run_dir / "quick_eval.csv", std::ios::app);
-  if (new_quick_eval) {
-    quick_eval_csv << "wall_s,policy_version,reached,episodes,mean_time_to_reach_s,"
-                      "mean_error_after_reach_m,kept\n";
-  }
+  if (new_quick_eval) quick_eval_csv << quick_eval_header << '\n';
   if (new_files) {
     episodes_csv << "wall_s,actor_id,episode_id,policy_version,return,length_steps,success,"
                     "final_distance_m,min_distance_m,beta_m,end_reason,thrust_energy\n";
@@ -437,14 +443,16 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   auto next_best_eval =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(rc.run.best_eval_period_s));
-  QuickScore best;
+  const QuickEvaluator quick(model, rc.task, rc.run.best_eval_suite);
+  const double max_hold_m = rc.run.best_eval_max_hold_m;
+  ValidationScore best;
   std::int64_t best_version = -1;
   if (options.resume && fs::exists(run_dir / "policy_best.nn")) {
     // A resumed run keeps its best policy unless a newer one scores better.
     try {
       const nn::Mlp previous =
           nn::network_from_bytes(nn::read_file((run_dir / "policy_best.nn").string()), 1);
-      best = quick_evaluate(model, rc.task, previous, rc.run.best_eval_suite);
+      best = quick.evaluate(previous);
       best_version = 0;
     } catch (const std::exception& e) {
       out << "auvrl train: " << (run_dir / "policy_best.nn").string()
@@ -564,8 +572,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         try {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
-          const QuickScore score = quick_evaluate(model, rc.task, net, rc.run.best_eval_suite);
-          const bool keep = best_version < 0 || score.better_than(best);
+          const ValidationScore score = quick.evaluate(net);
+          const bool keep = best_version < 0 || score.better_than(best, max_hold_m);
           if (keep) {
             best = score;
             best_version = w->version;
@@ -575,6 +583,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                          << score.reached << ',' << score.episodes << ',' << std::setprecision(2)
                          << (score.reached > 0 ? score.mean_time_s : 0.0) << ','
                          << std::setprecision(3) << (score.reached > 0 ? score.mean_hold_m : 0.0)
+                         << ',' << (score.max_time_ratio < 1e9 ? score.max_time_ratio : 0.0)
                          << ',' << (keep ? 1 : 0) << '\n';
           quick_eval_csv.flush();
         } catch (const std::exception& e) {
@@ -678,8 +687,9 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     // The last policy may be worse than the best seen: compare them on the quick evaluation.
     try {
       const nn::Mlp last = nn::network_from_bytes(nn::read_file(policy_path), 1);
-      const QuickScore last_score = quick_evaluate(model, rc.task, last, rc.run.best_eval_suite);
-      if (best.better_than(last_score)) policy_path = (run_dir / "policy_best.nn").string();
+      if (best.better_than(quick.evaluate(last), max_hold_m)) {
+        policy_path = (run_dir / "policy_best.nn").string();
+      }
     } catch (const std::exception&) {
       policy_path = (run_dir / "policy_best.nn").string();
     }

@@ -248,6 +248,83 @@ TEST(Evaluation, SummaryTableHasOneLinePerScenario) {
   EXPECT_NE(table.find("suite    pid                2/2"), std::string::npos) << table;
 }
 
+/// A suite row of episode i: reached at time_s (negative: never) with the given hold error.
+SummaryRow suite_row(int i, double time_s, double hold_m = 0.05) {
+  SummaryRow r;
+  r.scenario = "suite";
+  r.episode = i;
+  r.goal_ned_m = Eigen::Vector3d(i, -i, 5.0);
+  r.reached = time_s >= 0.0;
+  r.time_to_reach_s = time_s;
+  r.mean_error_after_reach_m = r.reached ? hold_m : -1.0;
+  return r;
+}
+
+TEST(ValidationScore, WorstRatioToTheReferenceOverTheWayPointsBothReached) {
+  const std::vector<SummaryRow> reference = {suite_row(0, 10.0), suite_row(1, 8.0),
+                                             suite_row(2, -1.0), suite_row(3, 12.0)};
+  // Faster on 0 and 3, slower on 1 (9.2 / 8.0 = 1.15), alone on 2 (no ratio there).
+  const std::vector<SummaryRow> rows = {suite_row(0, 9.0, 0.1), suite_row(1, 9.2, 0.2),
+                                        suite_row(2, 20.0, 0.3), suite_row(3, 6.0, 0.2)};
+  const ValidationScore s = score_against_reference(rows, reference);
+  EXPECT_EQ(s.episodes, 4);
+  EXPECT_EQ(s.reached, 4);
+  EXPECT_NEAR(s.max_time_ratio, 1.15, 1e-12);
+  EXPECT_NEAR(s.mean_time_s, (9.0 + 9.2 + 20.0 + 6.0) / 4, 1e-12);
+  EXPECT_NEAR(s.mean_hold_m, 0.2, 1e-12);
+
+  // Not reached: counted, but no time, hold or ratio.
+  const std::vector<SummaryRow> missed = {suite_row(0, -1.0), suite_row(1, 4.0),
+                                          suite_row(2, -1.0), suite_row(3, -1.0)};
+  const ValidationScore m = score_against_reference(missed, reference);
+  EXPECT_EQ(m.reached, 1);
+  EXPECT_NEAR(m.max_time_ratio, 0.5, 1e-12);
+  EXPECT_NEAR(m.mean_time_s, 4.0, 1e-12);
+}
+
+TEST(ValidationScore, RowsThatAreNotTheReferencesEpisodesAreAnError) {
+  const std::vector<SummaryRow> reference = {suite_row(0, 10.0), suite_row(1, 8.0)};
+  EXPECT_THROW(score_against_reference({suite_row(0, 9.0)}, reference), std::invalid_argument);
+  std::vector<SummaryRow> moved = {suite_row(0, 9.0), suite_row(1, 8.0)};
+  moved[1].goal_ned_m.x() += 1.0;
+  try {
+    score_against_reference(moved, reference);
+    FAIL() << "a different way-point was scored";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("episode 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ValidationScore, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
+  const double max_hold_m = 0.15;
+  ValidationScore a, b;
+  a.episodes = b.episodes = 40;
+  a.reached = 40;
+  b.reached = 39;
+  a.max_time_ratio = 2.0;
+  b.max_time_ratio = 0.8;
+  a.mean_hold_m = b.mean_hold_m = 0.05;
+  EXPECT_TRUE(a.better_than(b, max_hold_m));  // reaching more way-points comes first
+  EXPECT_FALSE(b.better_than(a, max_hold_m));
+
+  b.reached = 40;
+  EXPECT_TRUE(b.better_than(a, max_hold_m));  // then the worst ratio to the PID
+  EXPECT_FALSE(a.better_than(b, max_hold_m));
+
+  b.mean_hold_m = 0.2;  // faster, but drifting: holding within the limit comes before speed
+  EXPECT_TRUE(a.better_than(b, max_hold_m));
+  a.mean_hold_m = 0.3;  // both outside: the closer wins
+  EXPECT_TRUE(b.better_than(a, max_hold_m));
+
+  a.mean_hold_m = b.mean_hold_m = 0.05;
+  a.max_time_ratio = b.max_time_ratio = 0.9;
+  a.mean_time_s = 9.0;
+  b.mean_time_s = 9.5;
+  EXPECT_TRUE(a.better_than(b, max_hold_m));  // the same worst ratio: the shorter mean time
+  EXPECT_FALSE(b.better_than(a, max_hold_m));
+  EXPECT_FALSE(a.better_than(a, max_hold_m));
+}
+
 TEST(Evaluation, InfersTheLayoutFromThePolicyInputs) {
   EXPECT_EQ(infer_layout(18, 6), task::StateLayout::kPaper);
   EXPECT_EQ(infer_layout(23, 6), task::StateLayout::kExtended);
