@@ -274,8 +274,8 @@ TEST(ValidationScore, WorstRatioToTheReferenceOverTheWayPointsBothReached) {
   EXPECT_NEAR(s.mean_hold_m, 0.2, 1e-12);
 
   // Not reached: counted, but no time, hold or ratio.
-  const std::vector<SummaryRow> missed = {suite_row(0, -1.0), suite_row(1, 4.0),
-                                          suite_row(2, -1.0), suite_row(3, -1.0)};
+  const std::vector<SummaryRow> missed = {suite_row(0, -1.0), suite_row(1, 4.0), suite_row(2, -1.0),
+                                          suite_row(3, -1.0)};
   const ValidationScore m = score_against_reference(missed, reference);
   EXPECT_EQ(m.reached, 1);
   EXPECT_NEAR(m.max_time_ratio, 0.5, 1e-12);
