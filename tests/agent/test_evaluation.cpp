@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "agent/evaluation.hpp"
@@ -444,6 +445,42 @@ TEST(EvalCommand, RunsThePidEndToEnd) {
   request.out_dir = dir.path("run");
   request.vehicle_path = dir.path("no_vehicle.yaml");
   EXPECT_THROW(run_eval_request(request, out), std::runtime_error);
+}
+
+// The policy committed under config/ (README: `auvrl eval` works at once after install) still
+// loads with its layout and passes the paper's tests: within 0.5 m sooner than the paper
+// (25 s, 17 s, 30 s), holding within 0.3 m, and the whole suite. Guards the file against
+// changes to the network format, the state layout or the vehicle model.
+TEST(EvalCommand, TheCommittedPolicyPassesThePapersTests) {
+  TempDir dir;
+  EvalRequest request;
+  request.policy_path = std::string(AUVRL_CONFIG_DIR) + "/policies/fast_seed3.nn";
+  request.scenario = "all";
+  request.out_dir = dir.path("run");
+  request.vehicle_path = vehicle_path();
+  std::ostringstream out;
+  const std::vector<SummaryRow> rows = run_eval_request(request, out);
+  const std::vector<std::pair<std::string, double>> paper_times_s = {
+      {"test1", 25.0}, {"test2", 17.0}, {"fault", 30.0}};
+  for (const auto& [scenario, paper_time_s] : paper_times_s) {
+    bool found = false;
+    for (const SummaryRow& row : rows) {
+      if (row.scenario != scenario) continue;
+      found = true;
+      EXPECT_TRUE(row.reached) << scenario;
+      EXPECT_LT(row.time_to_reach_s, paper_time_s) << scenario;
+      EXPECT_LT(row.mean_error_after_reach_m, 0.3) << scenario;
+    }
+    EXPECT_TRUE(found) << scenario;
+  }
+  int suite = 0, suite_reached = 0;
+  for (const SummaryRow& row : rows) {
+    if (row.scenario != "suite") continue;
+    ++suite;
+    suite_reached += row.reached ? 1 : 0;
+  }
+  EXPECT_EQ(suite, 100);
+  EXPECT_GE(suite_reached, 95);
 }
 
 }  // namespace
