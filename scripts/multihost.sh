@@ -35,7 +35,9 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${AUVRL_BIN_DIR:-$root/build/bin}
 self=$(readlink -f "$0")
-usage() { sed -n '2,36p' "$self" | sed 's/^# \{0,1\}//'; exit 2; }
+# shellcheck source=scripts/lib/namespace_pid1.sh
+. "$root/scripts/lib/namespace_pid1.sh"
+usage() { sed -n '2,33p' "$self" | sed 's/^# \{0,1\}//'; exit 2; }
 
 transport=dds links=no-multicast ttl=0 loss=0 seconds=20 hidden=32-32 out="" check=0 ci=0
 inside=0
@@ -85,27 +87,12 @@ if [ "$inside" = 0 ]; then
   fi
   check_flag=()
   [ "$check" = 0 ] || check_flag=(--check)
-  unshare "${flags[@]}" -- "$self" --inside --transport "$transport" --links "$links" \
-    --lcm-ttl "$ttl" --loss "$loss" --seconds "$seconds" --hidden "$hidden" --out "$out" \
-    "${check_flag[@]}" &
-  unshare_pid=$!
-  # unshare ignores SIGTERM/SIGINT while it waits: pass them to PID 1 inside, which stops
-  # what it started; when PID 1 ends, the kernel ends every process left in its namespace
-  # (and --kill-child ends PID 1 if unshare itself is killed).
-  inner=""
-  for _ in $(seq 1 200); do
-    inner=$(pgrep -P "$unshare_pid" || true)
-    [ -n "$inner" ] && break
-    kill -0 "$unshare_pid" 2>/dev/null || break
-    sleep 0.01
-  done
-  trap '[ -n "$inner" ] && kill -TERM "$inner" 2>/dev/null || true' TERM INT HUP
-  status=0
-  while true; do
-    wait "$unshare_pid" && status=0 || status=$?
-    kill -0 "$unshare_pid" 2>/dev/null || break
-  done
-  exit "$status"
+  # unshare ignores SIGTERM/SIGINT while it waits: unshare_supervised passes them to PID 1
+  # inside, which stops what it started; when PID 1 ends, the kernel ends every process left
+  # in its namespace (and --kill-child ends PID 1 if unshare itself is killed).
+  unshare_supervised "" "${flags[@]}" -- "$self" --inside --transport "$transport" \
+    --links "$links" --lcm-ttl "$ttl" --loss "$loss" --seconds "$seconds" --hidden "$hidden" \
+    --out "$out" "${check_flag[@]}"
 fi
 
 # --- Inside: PID 1 of the private namespaces, in the bridge's network namespace. -----------

@@ -15,7 +15,9 @@
 # process: --join enters its network namespace, and SIGTERM to it stops the run.
 set -euo pipefail
 
-usage() { sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+# shellcheck source=scripts/lib/namespace_pid1.sh
+. "$(dirname "$(readlink -f "$0")")/lib/namespace_pid1.sh"
 
 setup_loopback() {
   ip link set lo up
@@ -35,11 +37,7 @@ case "$1" in
     child=$!
     trap 'kill -TERM "$child" 2>/dev/null || true' TERM INT HUP
     status=0
-    while true; do
-      wait "$child" && status=0 || status=$?
-      # wait returns early (status > 128) when a trapped signal arrives; keep waiting.
-      kill -0 "$child" 2>/dev/null || break
-    done
+    wait_for_exit "$child" || status=$?
     exit "$status"
     ;;
   --join)
@@ -52,7 +50,7 @@ case "$1" in
     fi
     ;;
   --network)
-    [ $# -ge 3 ] && [ "$2" = host ] || usage
+    if [ $# -lt 3 ] || [ "$2" != host ]; then usage; fi
     shift 2
     exec "$@"
     ;;
@@ -78,20 +76,4 @@ fi
 # unshare enters the new network namespace and forks PID 1 of the new PID namespace (the
 # --inside branch above); --kill-child ends that one if unshare itself is killed. unshare
 # blocks SIGINT/SIGTERM while it waits, so signals for the run go to PID 1 directly.
-unshare "${flags[@]}" --fork --kill-child=TERM -- "$self" --inside "$@" &
-unshare_pid=$!
-inner=""
-for _ in $(seq 1 200); do
-  inner=$(pgrep -P "$unshare_pid" || true)
-  [ -n "$inner" ] && break
-  kill -0 "$unshare_pid" 2>/dev/null || break
-  sleep 0.01
-done
-[ -n "$pidfile" ] && [ -n "$inner" ] && echo "$inner" >"$pidfile"
-trap '[ -n "$inner" ] && kill -TERM "$inner" 2>/dev/null || true' TERM INT HUP
-status=0
-while true; do
-  wait "$unshare_pid" && status=0 || status=$?
-  kill -0 "$unshare_pid" 2>/dev/null || break
-done
-exit "$status"
+unshare_supervised "$pidfile" "${flags[@]}" --fork --kill-child=TERM -- "$self" --inside "$@"
