@@ -116,13 +116,16 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
 /// How a candidate policy did on validation way-points, against a reference controller (the
 /// PID baseline) on the same way-points: what `auvrl train` keeps its best policy by.
 struct ValidationScore {
+  /// What a figure holds when nothing was reached (ranks below any real one).
+  static constexpr double kNone = 1e9;
+
   int reached = 0;
   int episodes = 0;
-  double mean_time_s = 1e9;  ///< mean time to reach over the reached way-points
-  double mean_hold_m = 1e9;  ///< mean hold error over the reached way-points
+  double mean_time_s = kNone;  ///< mean time to reach over the reached way-points
+  double mean_hold_m = kNone;  ///< mean hold error over the reached way-points
   /// Worst ratio of the candidate's time to reach to the reference's, over the way-points both
-  /// reached (1e9: none): below 1, it reached every way-point sooner than the reference.
-  double max_time_ratio = 1e9;
+  /// reached (kNone: none): below 1, it reached every way-point sooner than the reference.
+  double max_time_ratio = kNone;
 
   /// Ranks: more way-points reached; then a mean hold error within max_hold_m (or, both
   /// outside, the smaller); then the smaller worst ratio; then the shorter mean time. The worst

@@ -583,8 +583,10 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                          << score.reached << ',' << score.episodes << ',' << std::setprecision(2)
                          << (score.reached > 0 ? score.mean_time_s : 0.0) << ','
                          << std::setprecision(3) << (score.reached > 0 ? score.mean_hold_m : 0.0)
-                         << ',' << (score.max_time_ratio < 1e9 ? score.max_time_ratio : 0.0) << ','
-                         << (keep ? 1 : 0) << '\n';
+                         << ','
+                         << (score.max_time_ratio < ValidationScore::kNone ? score.max_time_ratio
+                                                                           : 0.0)
+                         << ',' << (keep ? 1 : 0) << '\n';
           quick_eval_csv.flush();
         } catch (const std::exception& e) {
           out << "auvrl train: quick evaluation failed: " << e.what() << "\n";

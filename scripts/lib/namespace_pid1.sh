@@ -14,6 +14,13 @@ wait_for_exit() {
   return "$status"
 }
 
+# forward_to_pid1: the signal handler of unshare_supervised.
+forward_to_pid1() {
+  if [ -n "${unshare_supervised_pid1:-}" ]; then
+    kill -TERM "$unshare_supervised_pid1" 2>/dev/null || true
+  fi
+}
+
 # unshare_supervised PIDFILE UNSHARE_ARGS...: runs `unshare UNSHARE_ARGS...` (which must
 # --fork into a new PID namespace) and stands in for it: writes the host PID of the new
 # namespace's PID 1 (unshare's child) to PIDFILE unless it is empty, passes SIGTERM, SIGINT
@@ -35,8 +42,7 @@ unshare_supervised() {
   if [ -n "$pidfile" ] && [ -n "$unshare_supervised_pid1" ]; then
     echo "$unshare_supervised_pid1" >"$pidfile"
   fi
-  trap '[ -n "$unshare_supervised_pid1" ] && kill -TERM "$unshare_supervised_pid1" 2>/dev/null || true' \
-    TERM INT HUP
+  trap 'forward_to_pid1' TERM INT HUP
   local status=0
   wait_for_exit "$unshare_supervised_pid" || status=$?
   exit "$status"
