@@ -30,13 +30,14 @@ unshare_supervised() {
   local pidfile=$1
   shift
   unshare "$@" &
-  unshare_supervised_pid=$!
+  local unshare_pid=$!
+  # Global, not local: forward_to_pid1 reads it when a signal arrives.
   unshare_supervised_pid1=""
   local _
   for _ in $(seq 1 200); do
-    unshare_supervised_pid1=$(pgrep -P "$unshare_supervised_pid" || true)
+    unshare_supervised_pid1=$(pgrep -P "$unshare_pid" || true)
     [ -n "$unshare_supervised_pid1" ] && break
-    kill -0 "$unshare_supervised_pid" 2>/dev/null || break
+    kill -0 "$unshare_pid" 2>/dev/null || break
     sleep 0.01
   done
   if [ -n "$pidfile" ] && [ -n "$unshare_supervised_pid1" ]; then
@@ -44,6 +45,6 @@ unshare_supervised() {
   fi
   trap 'forward_to_pid1' TERM INT HUP
   local status=0
-  wait_for_exit "$unshare_supervised_pid" || status=$?
+  wait_for_exit "$unshare_pid" || status=$?
   exit "$status"
 }
