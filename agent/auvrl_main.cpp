@@ -1,6 +1,6 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
-// library that does the work (agent/evaluation.hpp for eval); adding one is adding a row to
-// kSubcommands.
+// library that does the work (agent/evaluation.hpp for eval, agent/arrival_search.hpp for fastest);
+// adding one is adding a row to kSubcommands.
 #include <unistd.h>
 
 #include <cstdlib>
@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "agent/arrival_search.hpp"
 #include "agent/evaluation.hpp"
 #include "agent/launcher.hpp"
 #include "common/cli.hpp"
@@ -48,6 +49,37 @@ int run_eval(int argc, const char* const* argv) {
   if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
   request.seed = static_cast<std::uint64_t>(seed);
   auvrl::agent::run_eval_request(request, std::cout);
+  return 0;
+}
+
+/// `auvrl fastest`: how soon the vehicle could reach a scenario's way-point at all.
+int run_fastest(int argc, const char* const* argv) {
+  auvrl::agent::ArrivalSearchRequest request;
+  request.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+  std::int64_t seed = 1;
+  auvrl::cli::CommandLine cli(
+      "auvrl fastest",
+      "Searches open-loop thrust commands (cross-entropy method, started from the PID\n"
+      "baseline's) for the soonest arrival within 0.5 m of a scenario's way-point: what the\n"
+      "plant allows, to compare the learned policy and the PID with. Writes DIR/commands.csv\n"
+      "(auv_sim --open-loop format), summary.csv (the PID, and the commands with the PID\n"
+      "holding after them, as the evaluation measures them), search.csv and trajectories/.");
+  cli.option("scenario", &request.scenario, "test1|test2|fault|current");
+  cli.option("out", &request.out_dir, "output directory (created)");
+  cli.option("vehicle", &request.vehicle_path, "vehicle file");
+  cli.option("iterations", &request.search.iterations, "search iterations");
+  cli.option("population", &request.search.population, "samples per iteration");
+  cli.option("elites", &request.search.elites, "best samples kept per iteration");
+  cli.option("steps-per-segment", &request.search.steps_per_segment,
+             "control steps each searched command holds");
+  cli.option("stay-within", &request.search.stay_within_m,
+             "count an arrival only if the vehicle then stays within this many metres for 3 s "
+             "(default: arriving is enough)");
+  cli.option("seed", &seed, "seed of the search's draws");
+  if (!cli.parse(argc, argv)) return 0;
+  if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
+  request.search.seed = static_cast<std::uint64_t>(seed);
+  auvrl::agent::run_arrival_search_request(request, std::cout);
   return 0;
 }
 
@@ -133,6 +165,8 @@ struct Subcommand {
 const Subcommand kSubcommands[] = {
     {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
     {"eval", "evaluate a policy or the PID baseline on test1/test2/fault/current/suite", run_eval},
+    {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
+     run_fastest},
 };
 
 void print_usage(std::ostream& out) {

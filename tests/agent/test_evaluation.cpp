@@ -14,6 +14,7 @@
 
 #include "agent/evaluation.hpp"
 #include "agent/pid_controller.hpp"
+#include "agent_test_util.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 
@@ -21,52 +22,6 @@ namespace auvrl::agent {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-std::string vehicle_path() { return std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml"; }
-
-const sim::VehicleModel& nessie() {
-  static const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path());
-  return model;
-}
-
-/// A scratch directory for one test, removed at the end.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() /
-            ("auvrl_eval_test_" + std::to_string(rd()) + std::to_string(rd()));
-    std::filesystem::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string path(const std::string& name = "") const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> cells;
-  std::stringstream ss(line);
-  std::string cell;
-  while (std::getline(ss, cell, ',')) cells.push_back(cell);
-  if (!line.empty() && line.back() == ',') cells.emplace_back();
-  return cells;
-}
-
-std::vector<std::vector<std::string>> read_csv(const std::string& path) {
-  std::ifstream in(path);
-  EXPECT_TRUE(in.good()) << path;
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  while (std::getline(in, line)) rows.push_back(split(line));
-  return rows;
-}
 
 EvaluationConfig six_thruster_config() {
   EvaluationConfig c;
