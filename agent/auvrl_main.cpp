@@ -102,8 +102,8 @@ int run_train(int argc, const char* const* argv) {
       "Trains a policy with the whole system (auv_sim per actor, N auv_actor, auv_learner,\n"
       "auv_logger; over LCM or DDS: transport: in the configuration, or --transport) in a\n"
       "private network namespace, shows progress, restarts crashed processes,\n"
-      "stops cleanly on Ctrl-C, then evaluates the policy and the PID baseline, draws the plots\n"
-      "and writes RUN/report.md.");
+      "stops cleanly on Ctrl-C, then fine-tunes the policy (finetune: in the configuration),\n"
+      "evaluates it and the PID baseline, draws the plots and writes RUN/report.md.");
   cli.option("preset", &preset, "config/presets/NAME.yaml (paper or fast)");
   cli.option("config", &options.config_path, "a configuration file instead of a preset");
   cli.option("run-dir", &options.run_dir, "run directory (default runs/<preset>-<time>)");
@@ -112,6 +112,8 @@ int run_train(int argc, const char* const* argv) {
              "exploration actors (default: run.actors, 0 = one per CPU)");
   cli.option("max-seconds", &options.max_train_s, "training budget, s (default: run.max_train_s)");
   cli.option("seed", &options.seed, "seed of the run (default: run.seed)");
+  cli.option("finetune-iterations", &options.finetune_iterations,
+             "fine-tuning iterations after training (default: finetune.iterations, 0 = none)");
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
   cli.option("network", &network,
              "private (default: own network namespace) or host (LCM on the host's network)");
@@ -146,6 +148,9 @@ int run_train(int argc, const char* const* argv) {
     args.insert(args.end(), {"--max-seconds", std::to_string(options.max_train_s)});
   }
   if (options.seed >= 0) args.insert(args.end(), {"--seed", std::to_string(options.seed)});
+  if (options.finetune_iterations >= 0) {
+    args.insert(args.end(), {"--finetune-iterations", std::to_string(options.finetune_iterations)});
+  }
   if (no_eval) args.push_back("--no-eval");
   args.insert(args.end(), options.transport_args.begin(), options.transport_args.end());
   setenv("AUVRL_IN_NETNS", "1", 1);

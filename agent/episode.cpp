@@ -136,6 +136,10 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
     state.swap(next_state);
     previous_action = action;
     distance = next_distance;
+    if (options.steps_after_reach >= 0 && steps_after_reach > options.steps_after_reach) {
+      if (summary.end_reason == task::EndReason::kNone) summary.end_reason = outcome.reason;
+      break;
+    }
     if (outcome.done) {
       const bool keep_going = options.run_full_time &&
                               outcome.reason == task::EndReason::kReached && t < task.max_steps;

@@ -83,6 +83,9 @@ struct EpisodeOptions {
   /// Keep running after the task would end by reaching (evaluation: the full 70 s to see the
   /// vehicle hold station). Failures still end the episode.
   bool run_full_time = false;
+  /// With run_full_time: end the episode this many steps after first coming within
+  /// reach_radius_m (negative: run to max_steps). The fine-tuning's objective looks no further.
+  int steps_after_reach = -1;
   ExplorationNoise* noise = nullptr;  ///< none: the controller alone
   /// Labels every transition with what this controller would have commanded (it is reset with
   /// the episode and asked every step, but never drives). None: no labels.

@@ -205,7 +205,7 @@ Section load_file(const std::string& path) {
 namespace auvrl::config {
 
 void finish_run_file(Section& root) {
-  root.ignore({"vehicle", "task", "schedule", "learner", "actor", "run", "transport"});
+  root.ignore({"vehicle", "task", "schedule", "learner", "actor", "run", "transport", "finetune"});
   root.finish();
 }
 

@@ -160,6 +160,22 @@ TEST(RunEpisode, RunFullTimeKeepsGoingAfterReachingAndMeasuresTheHold) {
   EXPECT_NEAR(r.summary.final_distance_m, 0.4, 1e-9);
 }
 
+TEST(RunEpisode, StepsAfterReachEndsTheFullTimeRunThatManyStepsAfterArriving) {
+  const task::TaskConfig task = small_task();
+  ScriptedLink approach(6, [](int step, task::Observation& o, VehicleReport&) {
+    o.position_ned_m.x() = std::min(0.52 * step, 2.6);  // within 0.5 m at step 5
+  });
+  ConstantController controller(0.0f, task.state_dim());
+  EpisodeOptions options = goal_north(3.0);
+  options.run_full_time = true;
+  options.steps_after_reach = 7;
+  const EpisodeRun r = run(task, approach, controller, options);
+  EXPECT_NEAR(r.summary.time_to_reach_s, 0.5, 1e-12);
+  EXPECT_EQ(r.summary.length_steps, 5 + 7);
+  EXPECT_EQ(r.trajectory.size(), 12u);
+  EXPECT_NEAR(r.summary.mean_error_after_reach_m, 0.4, 1e-9);
+}
+
 TEST(RunEpisode, LeavingBetaMaxFails) {
   task::TaskConfig task = small_task();
   task.beta_max_m = 20.0;

@@ -165,6 +165,10 @@ TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
   }
   ASSERT_EQ(suite, 100) << train.log();
   final_error /= suite;
+  // The fine-tuning ran after the TD3 phase, every iteration in finetune.csv.
+  EXPECT_NE(train.log().find("auvrl train: fine-tuned: objective"), std::string::npos)
+      << train.log();
+  EXPECT_EQ(read_csv(fs::path(dir) / "finetune.csv").size(), 150u);
 
   // The untrained policy: the same architecture, freshly initialised.
   const sim::VehicleModel model =

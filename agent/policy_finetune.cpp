@@ -1,0 +1,231 @@
+#include "agent/policy_finetune.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "agent/controller.hpp"
+#include "agent/episode.hpp"
+#include "agent/vehicle_link.hpp"
+
+namespace auvrl::agent {
+
+void FinetuneConfig::validate() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw std::invalid_argument("finetune: " + what);
+  };
+  require(iterations >= 0, "iterations must be >= 0");
+  require(pairs >= 1, "pairs must be >= 1");
+  require(std::isfinite(sigma) && sigma > 0, "sigma must be > 0");
+  require(std::isfinite(learning_rate) && learning_rate > 0, "learning_rate must be > 0");
+  require(episodes >= 1, "episodes must be >= 1");
+  require(random_heading_fraction >= 0 && random_heading_fraction <= 1,
+          "random_heading_fraction must be in [0, 1]");
+  require(std::isfinite(hold_weight) && hold_weight >= 0, "hold_weight must be >= 0");
+  require(hold_steps >= 1, "hold_steps must be >= 1");
+  require(std::isfinite(flip_margin_rad) && flip_margin_rad > 0, "flip_margin_rad must be > 0");
+  require(std::isfinite(flip_margin_weight) && flip_margin_weight >= 0,
+          "flip_margin_weight must be >= 0");
+  require(episode_steps >= 1, "episode_steps must be >= 1");
+  require(threads >= 0, "threads must be >= 0");
+}
+
+std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
+                                               const FinetuneConfig& config, std::uint64_t seed) {
+  // A stream of its own: the evaluation's suite draws task::sample_goal from mt19937_64(1) and
+  // the launcher's validation from its own seed; mixing the run seed keeps them apart.
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    0xF17E7u, 0x5EEDu};
+  std::mt19937_64 rng(seq);
+  std::vector<FinetuneEpisode> episodes;
+  const int turned =
+      static_cast<int>(std::lround(config.random_heading_fraction * config.episodes));
+  for (int i = 0; i < config.episodes; ++i) {
+    FinetuneEpisode e;
+    e.goal_ned_m = task::sample_goal(task, rng);
+    e.start.position_ned_m = task.start_position_ned_m;
+    e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
+    // Spread the turned starts evenly through the list.
+    if (turned > 0 && (i * turned) / config.episodes != ((i + 1) * turned) / config.episodes) {
+      e.start.euler_rpy_rad[2] = (2.0 * task::unit_draw(rng) - 1.0) * 3.14159265358979323846;
+    }
+    e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
+    episodes.push_back(e);
+  }
+  return episodes;
+}
+
+double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
+                         Controller& controller, const FinetuneEpisode& episode,
+                         const FinetuneConfig& config, double reach_radius_m) {
+  task::TaskConfig t = task;
+  t.num_thrusters = model.num_thrusters();
+  t.max_thrust_n = model.thruster_dynamics.max_thrust_n;
+  t.control_step_s = model.control_step_s;
+  t.max_steps = config.episode_steps;
+  // The evaluation's episode (agent/evaluation.cpp), ended hold_steps after the arrival.
+  EpisodeOptions options;
+  options.goal_ned_m = episode.goal_ned_m;
+  options.beta_m = reach_radius_m;
+  options.start = episode.start;
+  options.reach_radius_m = reach_radius_m;
+  options.run_full_time = true;
+  options.steps_after_reach = config.hold_steps;
+  std::vector<TrajectoryRow> trajectory;
+  options.trajectory = &trajectory;
+  std::unique_ptr<VehicleLink> link = make_in_process_link(model);
+  run_episode(t, *link, controller, options);
+
+  const double dt = model.control_step_s;
+  double tilt_rad = 0.0;
+  for (const TrajectoryRow& row : trajectory) {
+    tilt_rad = std::max({tilt_rad, std::abs(row.observation.euler_rpy_rad[0]),
+                         std::abs(row.observation.euler_rpy_rad[1])});
+  }
+  const double margin_s =
+      config.flip_margin_weight * std::max(0.0, tilt_rad - config.flip_margin_rad);
+  double before = (episode.goal_ned_m - episode.start.position_ned_m).norm();
+  double closest_m = before;
+  for (std::size_t k = 0; k < trajectory.size(); ++k) {
+    const double d = trajectory[k].distance_m;
+    closest_m = std::min(closest_m, d);
+    if (d > reach_radius_m) {
+      before = d;
+      continue;
+    }
+    // Crossed during step k + 1: interpolate the moment the distance passed the radius.
+    const double fraction = before > d ? (before - reach_radius_m) / (before - d) : 1.0;
+    const double arrival_s = (static_cast<double>(k) + std::clamp(fraction, 0.0, 1.0)) * dt;
+    double sum_m = 0.0;
+    for (std::size_t j = k; j < trajectory.size(); ++j) sum_m += trajectory[j].distance_m;
+    const auto n = static_cast<double>(trajectory.size() - k);
+    return arrival_s + config.hold_weight * sum_m / n + margin_s;
+  }
+  return config.episode_steps * dt + closest_m + margin_s;
+}
+
+FinetuneResult finetune_policy(
+    const sim::VehicleModel& model, const task::TaskConfig& task, const nn::Mlp& start,
+    const FinetuneConfig& config, std::uint64_t seed,
+    const std::function<void(const FinetuneIteration&, const nn::Mlp& weights)>& progress,
+    const std::function<bool()>& stop) {
+  config.validate();
+  const int n = model.num_thrusters();
+  const int state_dim = task.state_dim();
+  // Throws if the network does not fit the task.
+  { PolicyController check(start, state_dim, n); }
+  const std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
+  const auto t0 = std::chrono::steady_clock::now();
+
+  int threads = config.threads > 0 ? config.threads
+                                   : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  threads = std::min(threads, 2 * config.pairs);
+  std::vector<PolicyController> workers;
+  for (int w = 0; w < threads; ++w) workers.emplace_back(start, state_dim, n);
+  nn::Mlp scratch = start;
+
+  // Mean objective of weights theta, with controller c (its network replaced).
+  auto objective = [&](PolicyController& c, const Eigen::VectorXf& theta) {
+    scratch = c.network();
+    scratch.params() = theta;
+    c.set_network(scratch);
+    double sum = 0.0;
+    for (const FinetuneEpisode& e : episodes) {
+      sum += arrival_objective(model, task, c, e, config);
+    }
+    return sum / static_cast<double>(episodes.size());
+  };
+
+  FinetuneResult result{start, 0.0, 0.0, 0, {}};
+  Eigen::VectorXf theta = start.params();
+  const Eigen::Index p = theta.size();
+  result.start_objective = objective(workers[0], theta);
+  result.best_objective = result.start_objective;
+  Eigen::VectorXf adam_m = Eigen::VectorXf::Zero(p), adam_v = Eigen::VectorXf::Zero(p);
+  std::mt19937_64 rng(seed ^ 0xE5E5E5E5ull);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  const int samples = 2 * config.pairs;
+  std::vector<Eigen::VectorXf> noise(static_cast<std::size_t>(config.pairs));
+  std::vector<double> value(static_cast<std::size_t>(samples));
+
+  for (int it = 1; it <= config.iterations; ++it) {
+    if (stop && stop()) break;
+    for (Eigen::VectorXf& eps : noise) {
+      eps.resize(p);
+      for (Eigen::Index j = 0; j < p; ++j) eps[j] = normal(rng);
+    }
+    // Sample s: pair s / 2, sign + for even s. Each worker takes every threads-th sample, so
+    // the values do not depend on the number of threads.
+    auto work = [&](int w) {
+      for (int s = w; s < samples; s += threads) {
+        const Eigen::VectorXf& eps = noise[static_cast<std::size_t>(s / 2)];
+        const float sign = s % 2 == 0 ? 1.0f : -1.0f;
+        PolicyController& c = workers[static_cast<std::size_t>(w)];
+        nn::Mlp net = c.network();
+        net.params() = theta + sign * static_cast<float>(config.sigma) * eps;
+        c.set_network(std::move(net));
+        double sum = 0.0;
+        for (const FinetuneEpisode& e : episodes) {
+          sum += arrival_objective(model, task, c, e, config);
+        }
+        value[static_cast<std::size_t>(s)] = sum / static_cast<double>(episodes.size());
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int w = 1; w < threads; ++w) pool.emplace_back(work, w);
+    work(0);
+    for (std::thread& t : pool) t.join();
+
+    // Rank shaping: the lowest objective gets +0.5, the highest -0.5 (robust to the scale
+    // and to the outliers of a way-point not reached).
+    std::vector<int> order(static_cast<std::size_t>(samples));
+    for (int s = 0; s < samples; ++s) order[static_cast<std::size_t>(s)] = s;
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return value[static_cast<std::size_t>(a)] < value[static_cast<std::size_t>(b)];
+    });
+    std::vector<double> utility(static_cast<std::size_t>(samples));
+    for (int r = 0; r < samples; ++r) {
+      utility[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] =
+          0.5 - static_cast<double>(r) / static_cast<double>(samples - 1);
+    }
+    Eigen::VectorXf direction = Eigen::VectorXf::Zero(p);
+    for (int k = 0; k < config.pairs; ++k) {
+      direction += static_cast<float>(utility[static_cast<std::size_t>(2 * k)] -
+                                      utility[static_cast<std::size_t>(2 * k + 1)]) *
+                   noise[static_cast<std::size_t>(k)];
+    }
+    direction /= static_cast<float>(config.pairs * config.sigma);
+    adam_m = 0.9f * adam_m + 0.1f * direction;
+    adam_v = 0.999f * adam_v + 0.001f * direction.cwiseProduct(direction);
+    const float m_hat_scale = 1.0f / (1.0f - std::pow(0.9f, static_cast<float>(it)));
+    const float v_hat_scale = 1.0f / (1.0f - std::pow(0.999f, static_cast<float>(it)));
+    theta +=
+        static_cast<float>(config.learning_rate) *
+        ((adam_m.array() * m_hat_scale) / ((adam_v.array() * v_hat_scale).sqrt() + 1e-8f)).matrix();
+
+    FinetuneIteration stats;
+    stats.iteration = it;
+    stats.objective = objective(workers[0], theta);
+    stats.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (stats.objective < result.best_objective) {
+      result.best_objective = stats.objective;
+      result.best_iteration = it;
+      result.network.params() = theta;
+    }
+    result.iterations.push_back(stats);
+    if (progress) {
+      scratch.params() = theta;
+      progress(stats, scratch);
+    }
+  }
+  return result;
+}
+
+}  // namespace auvrl::agent

@@ -1,0 +1,171 @@
+// Evolution-strategies fine-tuning (agent/policy_finetune.hpp): its way-points, the per-way-point
+// objective against the evaluation's own figures, that it lowers the objective of a trained
+// policy, that the thread count does not change the result, and that bad settings are refused.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "agent/pid_controller.hpp"
+#include "agent/policy_finetune.hpp"
+#include "agent_test_util.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+
+namespace auvrl::agent {
+namespace {
+
+task::TaskConfig fast_task() {
+  task::TaskConfig t;
+  t.layout = task::StateLayout::kExtendedThrust;
+  t.num_thrusters = 6;
+  t.max_thrust_n = nessie().thruster_dynamics.max_thrust_n;
+  return t;
+}
+
+nn::Mlp committed_policy() {
+  return nn::network_from_bytes(
+      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast_seed3.nn"), 1);
+}
+
+TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
+  FinetuneConfig c;
+  c.episodes = 20;
+  c.random_heading_fraction = 0.25;
+  const task::TaskConfig t = fast_task();
+  const auto a = finetune_episodes(t, c, 7);
+  const auto b = finetune_episodes(t, c, 7);
+  const auto other = finetune_episodes(t, c, 8);
+  ASSERT_EQ(a.size(), 20u);
+  int turned = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].goal_ned_m, b[i].goal_ned_m);
+    EXPECT_NE(a[i].goal_ned_m, other[i].goal_ned_m);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(a[i].goal_ned_m[k], t.goal_min_ned_m[k]);
+      EXPECT_LE(a[i].goal_ned_m[k], t.goal_max_ned_m[k]);
+    }
+    EXPECT_EQ(a[i].start.position_ned_m, t.start_position_ned_m);
+    if (a[i].start.euler_rpy_rad[2] != t.start_yaw_rad) ++turned;
+  }
+  EXPECT_EQ(turned, 5);
+  // Never the evaluation suite's way-points (task::sample_goal from mt19937_64(1)).
+  std::mt19937_64 suite_rng(1);
+  const Eigen::Vector3d first_suite_goal = task::sample_goal(t, suite_rng);
+  for (const auto& e : a) EXPECT_NE(e.goal_ned_m, first_suite_goal);
+}
+
+TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
+  const task::TaskConfig t = fast_task();
+  FinetuneEpisode e;
+  e.goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);  // test1
+  FinetuneConfig c;
+  c.episode_steps = 300;
+  PidController pid(nessie());
+  c.hold_weight = 0.0;
+  const double arrival_s = arrival_objective(nessie(), t, pid, e, c);
+  // The evaluation's test1 figure for the PID is the first whole step within 0.5 m.
+  EvaluationConfig eval;
+  eval.task = t;
+  EvaluationEpisode test1;
+  test1.goal_ned_m = e.goal_ned_m;
+  test1.start = e.start;
+  const SummaryRow row = run_evaluation_episode(nessie(), eval, pid, test1, nullptr);
+  ASSERT_TRUE(row.reached);
+  EXPECT_GT(arrival_s, row.time_to_reach_s - 0.1);
+  EXPECT_LE(arrival_s, row.time_to_reach_s);
+  c.hold_weight = 2.0;
+  c.hold_steps = 700;  // longer than the rest of the episode: the mean of what is left
+  const double with_hold = arrival_objective(nessie(), t, pid, e, c);
+  EXPECT_GT(with_hold, arrival_s);
+  EXPECT_LT(with_hold, arrival_s + 2.0 * 0.5);
+}
+
+/// Never pushes.
+class IdleController final : public Controller {
+ public:
+  void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector&,
+           task::ActionVector& action) override {
+    action = task::ActionVector::Zero(6);
+  }
+  std::string name() const override { return "idle"; }
+};
+
+TEST(ArrivalObjective, NotArrivingCostsTheEpisodeTimePlusTheClosestApproach) {
+  FinetuneEpisode e;
+  e.goal_ned_m = Eigen::Vector3d(3.0, 4.0, 5.0);  // 5 m ahead of the start, level
+  FinetuneConfig c;
+  c.episode_steps = 50;
+  IdleController idle;
+  const double j = arrival_objective(nessie(), fast_task(), idle, e, c);
+  EXPECT_NEAR(j, 5.0 + 5.0, 0.05) << "the vehicle barely drifts (1 N buoyant)";
+}
+
+FinetuneConfig small_finetune() {
+  FinetuneConfig c;
+  c.iterations = 4;
+  c.pairs = 4;
+  c.episodes = 4;
+  return c;
+}
+
+TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
+  FinetuneConfig c = small_finetune();
+  std::vector<FinetuneIteration> seen;
+  const FinetuneResult r =
+      finetune_policy(nessie(), fast_task(), committed_policy(), c, 1,
+                      [&](const FinetuneIteration& i, const nn::Mlp& weights) {
+                        seen.push_back(i);
+                        EXPECT_EQ(weights.num_params(), committed_policy().num_params());
+                      });
+  ASSERT_EQ(seen.size(), 4u);
+  ASSERT_EQ(r.iterations.size(), 4u);
+  EXPECT_EQ(seen.back().iteration, 4);
+  EXPECT_GE(seen.back().elapsed_s, seen.front().elapsed_s);
+  EXPECT_LT(r.best_objective, r.start_objective - 0.05);
+  EXPECT_GT(r.best_iteration, 0);
+  EXPECT_EQ(r.best_objective,
+            r.iterations[static_cast<std::size_t>(r.best_iteration - 1)].objective);
+  // The returned network is the one that scored best_objective.
+  PolicyController best(r.network, fast_task().state_dim(), 6);
+  double sum = 0.0;
+  for (const FinetuneEpisode& e : finetune_episodes(fast_task(), c, 1)) {
+    sum += arrival_objective(nessie(), fast_task(), best, e, c);
+  }
+  EXPECT_NEAR(sum / c.episodes, r.best_objective, 1e-12);
+}
+
+TEST(FinetunePolicy, TheNumberOfThreadsDoesNotChangeTheResult) {
+  FinetuneConfig c = small_finetune();
+  c.iterations = 2;
+  c.threads = 1;
+  const FinetuneResult one = finetune_policy(nessie(), fast_task(), committed_policy(), c, 3);
+  c.threads = 3;
+  const FinetuneResult three = finetune_policy(nessie(), fast_task(), committed_policy(), c, 3);
+  EXPECT_EQ(one.network.params(), three.network.params());
+  EXPECT_EQ(one.best_objective, three.best_objective);
+}
+
+TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
+  FinetuneConfig c = small_finetune();
+  c.sigma = 0.0;
+  EXPECT_THROW(finetune_policy(nessie(), fast_task(), committed_policy(), c, 1),
+               std::invalid_argument);
+  for (auto bad :
+       {+[](FinetuneConfig& f) { f.pairs = 0; }, +[](FinetuneConfig& f) { f.episodes = 0; },
+        +[](FinetuneConfig& f) { f.learning_rate = -1; },
+        +[](FinetuneConfig& f) { f.random_heading_fraction = 2; },
+        +[](FinetuneConfig& f) { f.hold_steps = 0; },
+        +[](FinetuneConfig& f) { f.iterations = -1; }}) {
+    FinetuneConfig f;
+    bad(f);
+    EXPECT_THROW(f.validate(), std::invalid_argument);
+  }
+  task::TaskConfig paper = fast_task();
+  paper.layout = task::StateLayout::kPaper;
+  EXPECT_THROW(finetune_policy(nessie(), paper, committed_policy(), small_finetune(), 1),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace auvrl::agent
