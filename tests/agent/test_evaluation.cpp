@@ -409,7 +409,7 @@ TEST(EvalCommand, RunsThePidEndToEnd) {
 TEST(EvalCommand, TheCommittedPolicyPassesThePapersTests) {
   TempDir dir;
   EvalRequest request;
-  request.policy_path = std::string(AUVRL_CONFIG_DIR) + "/policies/fast_seed3.nn";
+  request.policy_path = std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn";
   request.scenario = "all";
   request.out_dir = dir.path("run");
   request.vehicle_path = vehicle_path();

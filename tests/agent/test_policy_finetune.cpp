@@ -25,7 +25,7 @@ task::TaskConfig fast_task() {
 
 nn::Mlp committed_policy() {
   return nn::network_from_bytes(
-      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast_seed3.nn"), 1);
+      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
 }
 
 TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
