@@ -1220,6 +1220,38 @@ def write_report(run, ctrls, tr, figures, path):
                  "missing).")
         L.append("")
 
+    # --- Fine-tuning (finetune.csv, only in runs that fine-tuned). ---
+    ft_rows = read_csv(os.path.join(run, "finetune.csv"),
+                       {"iteration": parse_float, "objective_s": parse_float,
+                        "elapsed_s": parse_float,
+                        "validation_reached": parse_float_or_empty,
+                        "validation_mean_time_s": parse_float_or_empty,
+                        "validation_hold_m": parse_float_or_empty,
+                        "validation_worst_time_ratio": parse_float_or_empty},
+                       "finetune.csv", required=("iteration", "objective_s"))
+    if ft_rows:
+        L.append("## Fine-tuning")
+        L.append("")
+        L.append(f"{len(ft_rows)} iterations of evolution strategies in "
+                 f"{fmt_duration(ft_rows[-1]['elapsed_s'])}; objective (mean over the "
+                 "fine-tuning's way-points of the time to within 0.5 m plus the weighted hold "
+                 f"error) {fmt(ft_rows[0]['objective_s'], 3, ' s')} after the first iteration, "
+                 f"{fmt(ft_rows[-1]['objective_s'], 3, ' s')} after the last. Validation "
+                 "way-points at the checkpoints (the kept one is named above, as the "
+                 "evaluated policy):")
+        L.append("")
+        table = []
+        for r in ft_rows:
+            if r["validation_reached"] is None or not np.isfinite(r["validation_reached"]):
+                continue
+            table.append([int(r["iteration"]), fmt(r["objective_s"], 3, " s"),
+                          int(r["validation_reached"]), fmt(r["validation_mean_time_s"], 2, " s"),
+                          fmt(r["validation_hold_m"], 3, " m"),
+                          fmt(r["validation_worst_time_ratio"], 2)])
+        L.append(md_table(["iteration", "objective", "reached", "mean time", "hold error",
+                           "worst time ratio to the PID"], table))
+        L.append("")
+
     # --- What was missing or damaged. ---
     L.append("## Inputs missing or damaged")
     L.append("")

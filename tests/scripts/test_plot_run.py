@@ -130,6 +130,13 @@ def fabricate(run):
                   f"{s // 5}")
     write(os.path.join(run, "learner.csv"), "\n".join(le) + "\n")
     # progress.csv is left out on purpose.
+    # ---- Fine-tuning: 20 iterations, validation every 10. ----
+    ft = ["iteration,objective_s,elapsed_s,validation_reached,validation_mean_time_s,"
+          "validation_hold_m,validation_worst_time_ratio"]
+    for i in range(1, 21):
+        tail = f",{60 - (i == 10)},{9.5 - i / 100:.2f},0.08,1.1" if i % 10 == 0 else ",,,,"
+        ft.append(f"{i},{10.0 - i / 20:.3f},{0.3 * i:.1f}" + tail)
+    write(os.path.join(run, "finetune.csv"), "\n".join(ft) + "\n")
 
 
 class PlotRunTest(unittest.TestCase):
@@ -204,6 +211,13 @@ class PlotRunTest(unittest.TestCase):
         self.assertIn("| transitions received / replay buffer | 210000 / 100000 |",
                       self.report)
         self.assertIn("| wall-clock time | 10.0 min (600 s) |", self.report)
+
+    def test_finetuning_summary(self):
+        self.assertIn("## Fine-tuning", self.report)
+        self.assertIn("20 iterations of evolution strategies in 6 s", self.report)
+        self.assertIn("9.950 s after the first iteration, 9.000 s after the last", self.report)
+        self.assertIn("| 10 | 9.500 s | 59 | 9.40 s | 0.080 m | 1.10 |", self.report)
+        self.assertIn("| 20 | 9.000 s | 60 | 9.30 s | 0.080 m | 1.10 |", self.report)
 
     def test_damage_reported_with_file_and_line(self):
         self.assertIn("eval/policy/summary.csv:12: 5 fields, expected 12; row skipped",
