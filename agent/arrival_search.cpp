@@ -37,9 +37,7 @@ namespace {
 
 /// The evaluation's config as run_evaluation completes it from the model.
 EvaluationConfig completed(EvaluationConfig config, const sim::VehicleModel& model) {
-  config.task.num_thrusters = model.num_thrusters();
-  config.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
-  config.task.control_step_s = model.control_step_s;
+  apply_vehicle(model, config.task);
   config.task.max_steps = config.episode_steps;
   config.task.validate();
   return config;

@@ -147,6 +147,12 @@ std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config,
   return {};
 }
 
+void apply_vehicle(const sim::VehicleModel& model, task::TaskConfig& task) {
+  task.num_thrusters = model.num_thrusters();
+  task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
+  task.control_step_s = model.control_step_s;
+}
+
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
                                   Controller& controller, const EvaluationEpisode& episode,
                                   std::vector<TrajectoryRow>* trajectory) {
@@ -192,9 +198,7 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
                                        Controller& controller,
                                        const std::vector<Scenario>& scenarios,
                                        const std::string& out_dir) {
-  config.task.num_thrusters = model.num_thrusters();
-  config.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
-  config.task.control_step_s = model.control_step_s;
+  apply_vehicle(model, config.task);
   config.task.max_steps = config.episode_steps;  // checked here; each episode applies it
   config.task.validate();
   if (!(config.reach_radius_m > 0)) {

@@ -143,9 +143,7 @@ class QuickEvaluator {
                  int turned = 0)
       : model_(model), task_(task) {
     config_.task = task;
-    config_.task.num_thrusters = model.num_thrusters();
-    config_.task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
-    config_.task.control_step_s = model.control_step_s;
+    apply_vehicle(model, config_.task);
     config_.suite_episodes = suite_episodes + turned;
     // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
     // and the suite's seed 1) must not be the ones that choose the policy, or the reported

@@ -66,9 +66,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
                          Controller& controller, const FinetuneEpisode& episode,
                          const FinetuneConfig& config, double reach_radius_m) {
   task::TaskConfig t = task;
-  t.num_thrusters = model.num_thrusters();
-  t.max_thrust_n = model.thruster_dynamics.max_thrust_n;
-  t.control_step_s = model.control_step_s;
+  apply_vehicle(model, t);
   t.max_steps = config.episode_steps;
   // The evaluation's episode (agent/evaluation.cpp), ended hold_steps after the arrival.
   EpisodeOptions options;
