@@ -24,8 +24,8 @@ task::TaskConfig fast_task() {
 }
 
 nn::Mlp committed_policy() {
-  return nn::network_from_bytes(
-      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  return nn::network_from_bytes(nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"),
+                                1);
 }
 
 TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
