@@ -93,6 +93,9 @@ RunConfig read_run_config(const std::string& path) {
   finetune.read("flip_margin_rad", c.finetune.flip_margin_rad);
   finetune.read("flip_margin_weight", c.finetune.flip_margin_weight);
   finetune.read("episode_steps", c.finetune.episode_steps);
+  finetune.read("pid_lag_weight", c.finetune.pid_lag_weight);
+  finetune.read("pid_lead_s", c.finetune.pid_lead_s);
+  finetune.read("integration_substeps", c.finetune.integration_substeps);
   finetune.read("threads", c.finetune.threads);
   finetune.finish();
   try {

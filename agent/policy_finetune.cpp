@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -13,6 +14,7 @@
 
 #include "agent/controller.hpp"
 #include "agent/episode.hpp"
+#include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
 
 namespace auvrl::agent {
@@ -34,6 +36,9 @@ void FinetuneConfig::validate() const {
   require(std::isfinite(flip_margin_weight) && flip_margin_weight >= 0,
           "flip_margin_weight must be >= 0");
   require(episode_steps >= 1, "episode_steps must be >= 1");
+  require(std::isfinite(pid_lag_weight) && pid_lag_weight >= 0, "pid_lag_weight must be >= 0");
+  require(std::isfinite(pid_lead_s), "pid_lead_s must be finite");
+  require(integration_substeps >= 0, "integration_substeps must be >= 0");
   require(threads >= 0, "threads must be >= 0");
 }
 
@@ -62,11 +67,27 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   return episodes;
 }
 
+void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& task,
+                      const FinetuneConfig& config, std::vector<FinetuneEpisode>& episodes) {
+  // The objective with nothing but the arrival priced: the interpolated arrival time (or, not
+  // arriving, the episode's time plus the closest approach).
+  FinetuneConfig arrival_only = config;
+  arrival_only.hold_weight = 0.0;
+  arrival_only.flip_margin_weight = 0.0;
+  arrival_only.pid_lag_weight = 0.0;
+  PidController pid(model);
+  for (FinetuneEpisode& e : episodes) {
+    e.pid_arrival_s = arrival_objective(model, task, pid, e, arrival_only);
+  }
+}
+
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
                          Controller& controller, const FinetuneEpisode& episode,
                          const FinetuneConfig& config, double reach_radius_m) {
+  sim::VehicleModel plant = model;
+  if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
-  apply_vehicle(model, t);
+  apply_vehicle(plant, t);
   t.max_steps = config.episode_steps;
   // The evaluation's episode (agent/evaluation.cpp), ended hold_steps after the arrival.
   EpisodeOptions options;
@@ -78,10 +99,10 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   options.steps_after_reach = config.hold_steps;
   std::vector<TrajectoryRow> trajectory;
   options.trajectory = &trajectory;
-  std::unique_ptr<VehicleLink> link = make_in_process_link(model);
+  std::unique_ptr<VehicleLink> link = make_in_process_link(plant);
   run_episode(t, *link, controller, options);
 
-  const double dt = model.control_step_s;
+  const double dt = plant.control_step_s;
   double tilt_rad = 0.0;
   for (const TrajectoryRow& row : trajectory) {
     tilt_rad = std::max({tilt_rad, std::abs(row.observation.euler_rpy_rad[0]),
@@ -89,6 +110,12 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   }
   const double margin_s =
       config.flip_margin_weight * std::max(0.0, tilt_rad - config.flip_margin_rad);
+  // Time behind the PID's arrival less the lead asked for, if any.
+  auto lag_s = [&](double arrival_s) {
+    if (!std::isfinite(episode.pid_arrival_s)) return 0.0;
+    return config.pid_lag_weight *
+           std::max(0.0, arrival_s - (episode.pid_arrival_s - config.pid_lead_s));
+  };
   double before = (episode.goal_ned_m - episode.start.position_ned_m).norm();
   double closest_m = before;
   for (std::size_t k = 0; k < trajectory.size(); ++k) {
@@ -104,9 +131,10 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
     double sum_m = 0.0;
     for (std::size_t j = k; j < trajectory.size(); ++j) sum_m += trajectory[j].distance_m;
     const auto n = static_cast<double>(trajectory.size() - k);
-    return arrival_s + config.hold_weight * sum_m / n + margin_s;
+    return arrival_s + config.hold_weight * sum_m / n + margin_s + lag_s(arrival_s);
   }
-  return config.episode_steps * dt + closest_m + margin_s;
+  const double give_up_s = config.episode_steps * dt;
+  return give_up_s + closest_m + margin_s + lag_s(give_up_s);
 }
 
 FinetuneResult finetune_policy(
@@ -119,7 +147,8 @@ FinetuneResult finetune_policy(
   const int state_dim = task.state_dim();
   // Throws if the network does not fit the task.
   { PolicyController check(start, state_dim, n); }
-  const std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
+  std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
+  if (config.pid_lag_weight > 0) set_pid_arrivals(model, task, config, episodes);
   const auto t0 = std::chrono::steady_clock::now();
 
   int threads = config.threads > 0 ? config.threads

@@ -1,10 +1,15 @@
 // Evolution-strategies fine-tuning (agent/policy_finetune.hpp): its way-points, the per-way-point
-// objective against the evaluation's own figures, that it lowers the objective of a trained
-// policy, that the thread count does not change the result, and that bad settings are refused.
+// objective against the evaluation's own figures (its PID lag term and its coarser integrator
+// too), that it lowers the objective of a trained policy, that the thread count does not change
+// the result, and that bad settings are refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "agent/pid_controller.hpp"
 #include "agent/policy_finetune.hpp"
@@ -81,6 +86,33 @@ TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   EXPECT_LT(with_hold, arrival_s + 2.0 * 0.5);
 }
 
+TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
+  const task::TaskConfig t = fast_task();
+  FinetuneConfig c;
+  c.episode_steps = 300;
+  c.hold_weight = 0.0;
+  std::vector<FinetuneEpisode> episodes(1);
+  episodes[0].goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);  // test1
+  PidController pid(nessie());
+  const double pid_arrival_s = arrival_objective(nessie(), t, pid, episodes[0], c);
+  c.pid_lag_weight = 4.0;
+  c.pid_lead_s = 0.3;
+  set_pid_arrivals(nessie(), t, c, episodes);
+  EXPECT_EQ(episodes[0].pid_arrival_s, pid_arrival_s);
+  EXPECT_GT(pid_arrival_s, 8.1);
+  EXPECT_LT(pid_arrival_s, 8.3);
+  // The PID itself arrives 0.3 s later than asked: 4 s per s of it.
+  EXPECT_NEAR(arrival_objective(nessie(), t, pid, episodes[0], c), pid_arrival_s + 4.0 * 0.3, 1e-9);
+  // A lead of -0.5 s lets it be up to 0.5 s later for nothing.
+  c.pid_lead_s = -0.5;
+  EXPECT_EQ(arrival_objective(nessie(), t, pid, episodes[0], c), pid_arrival_s);
+  // Without the PID's arrival there is nothing to lag behind.
+  FinetuneEpisode no_reference = episodes[0];
+  no_reference.pid_arrival_s = std::numeric_limits<double>::quiet_NaN();
+  c.pid_lead_s = 0.3;
+  EXPECT_EQ(arrival_objective(nessie(), t, pid, no_reference, c), pid_arrival_s);
+}
+
 /// Never pushes.
 class IdleController final : public Controller {
  public:
@@ -101,6 +133,30 @@ TEST(ArrivalObjective, NotArrivingCostsTheEpisodeTimePlusTheClosestApproach) {
   EXPECT_NEAR(j, 5.0 + 5.0, 0.05) << "the vehicle barely drifts (1 N buoyant)";
 }
 
+TEST(ArrivalObjective, ACoarserIntegratorGivesTheSameObjectiveForATrainedPolicy) {
+  // The fine-tuning's episodes may run RK4 with fewer steps than the vehicle file's 10 (the
+  // fast preset runs 2): the policy's objective must not move with it, or the fine-tuning
+  // would rank weights on another plant. A single substep is visibly coarser.
+  FinetuneConfig c;
+  c.episodes = 6;
+  c.random_heading_fraction = 0.5;
+  const nn::Mlp policy = committed_policy();
+  PolicyController controller(policy, fast_task().state_dim(), 6);
+  ASSERT_EQ(nessie().substeps, 10);
+  double largest_gap_s = 0.0;
+  for (const FinetuneEpisode& e : finetune_episodes(fast_task(), c, 5)) {
+    c.integration_substeps = 0;  // the vehicle's own
+    const double fine = arrival_objective(nessie(), fast_task(), controller, e, c);
+    c.integration_substeps = 10;
+    EXPECT_EQ(arrival_objective(nessie(), fast_task(), controller, e, c), fine);
+    c.integration_substeps = 2;
+    const double coarse = arrival_objective(nessie(), fast_task(), controller, e, c);
+    largest_gap_s = std::max(largest_gap_s, std::abs(coarse - fine));
+  }
+  EXPECT_LT(largest_gap_s, 1e-3);
+  EXPECT_GT(largest_gap_s, 0.0) << "the substeps did not reach the simulation";
+}
+
 FinetuneConfig small_finetune() {
   FinetuneConfig c;
   c.iterations = 4;
@@ -111,6 +167,11 @@ FinetuneConfig small_finetune() {
 
 TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
   FinetuneConfig c = small_finetune();
+  // The PID's arrivals are part of the objective (the committed policy is more than the
+  // preset's 0.3 s ahead of the PID on these way-points: a lead of 1 s makes the term count).
+  c.pid_lag_weight = 4.0;
+  c.pid_lead_s = 1.0;
+  c.integration_substeps = 2;
   std::vector<FinetuneIteration> seen;
   const FinetuneResult r =
       finetune_policy(nessie(), fast_task(), committed_policy(), c, 1,
@@ -126,13 +187,24 @@ TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
   EXPECT_GT(r.best_iteration, 0);
   EXPECT_EQ(r.best_objective,
             r.iterations[static_cast<std::size_t>(r.best_iteration - 1)].objective);
-  // The returned network is the one that scored best_objective.
+  // The returned network is the one that scored best_objective, on the way-points with the
+  // PID's arrivals; without them the lag term would be missing.
+  std::vector<FinetuneEpisode> episodes = finetune_episodes(fast_task(), c, 1);
+  PolicyController start(committed_policy(), fast_task().state_dim(), 6);
   PolicyController best(r.network, fast_task().state_dim(), 6);
-  double sum = 0.0;
-  for (const FinetuneEpisode& e : finetune_episodes(fast_task(), c, 1)) {
+  double start_without_pid = 0.0;
+  for (const FinetuneEpisode& e : episodes) {
+    start_without_pid += arrival_objective(nessie(), fast_task(), start, e, c);
+  }
+  set_pid_arrivals(nessie(), fast_task(), c, episodes);
+  double sum = 0.0, start_sum = 0.0;
+  for (const FinetuneEpisode& e : episodes) {
     sum += arrival_objective(nessie(), fast_task(), best, e, c);
+    start_sum += arrival_objective(nessie(), fast_task(), start, e, c);
   }
   EXPECT_NEAR(sum / c.episodes, r.best_objective, 1e-12);
+  EXPECT_NEAR(start_sum / c.episodes, r.start_objective, 1e-12);
+  EXPECT_GT(start_sum, start_without_pid) << "the start lags the PID on none of the way-points";
 }
 
 TEST(FinetunePolicy, TheNumberOfThreadsDoesNotChangeTheResult) {
@@ -156,6 +228,9 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.learning_rate = -1; },
         +[](FinetuneConfig& f) { f.random_heading_fraction = 2; },
         +[](FinetuneConfig& f) { f.hold_steps = 0; },
+        +[](FinetuneConfig& f) { f.integration_substeps = -1; },
+        +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
+        +[](FinetuneConfig& f) { f.pid_lead_s = std::numeric_limits<double>::infinity(); },
         +[](FinetuneConfig& f) { f.iterations = -1; }}) {
     FinetuneConfig f;
     bad(f);
