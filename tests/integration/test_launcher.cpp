@@ -172,7 +172,16 @@ TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
   std::string line;
   int finetune_lines = 0;
   while (std::getline(finetune_csv, line)) ++finetune_lines;
-  EXPECT_EQ(finetune_lines, 1 + 150) << "the header and one row per iteration";
+  // The preset's iteration count: the first "  iterations: N" after "finetune:".
+  std::ifstream preset(kPreset);
+  std::stringstream preset_text;
+  preset_text << preset.rdbuf();
+  std::smatch iterations;
+  const std::string text = preset_text.str();
+  ASSERT_TRUE(std::regex_search(text, iterations,
+                                std::regex(R"(\nfinetune:\n(?:[ ]+#.*\n)*  iterations: (\d+))")))
+      << kPreset;
+  EXPECT_EQ(finetune_lines, 1 + std::stoi(iterations[1])) << "the header and one row per iteration";
 
   // The untrained policy: the same architecture, freshly initialised.
   const sim::VehicleModel model =
