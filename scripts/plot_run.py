@@ -1235,7 +1235,9 @@ def write_report(run, ctrls, tr, figures, path):
         L.append(f"{len(ft_rows)} iterations of evolution strategies in "
                  f"{fmt_duration(ft_rows[-1]['elapsed_s'])}; objective (mean over the "
                  "fine-tuning's way-points of the time to within 0.5 m plus the weighted hold "
-                 f"error) {fmt(ft_rows[0]['objective_s'], 3, ' s')} after the first iteration, "
+                 "error, tilt beyond the flip margin and lag behind the PID: config.yaml's "
+                 f"finetune section) {fmt(ft_rows[0]['objective_s'], 3, ' s')} after the first "
+                 "iteration, "
                  f"{fmt(ft_rows[-1]['objective_s'], 3, ' s')} after the last. Validation "
                  "way-points at the checkpoints (the kept one is named above, as the "
                  "evaluated policy):")
