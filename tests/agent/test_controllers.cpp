@@ -6,9 +6,9 @@
 #include <stdexcept>
 
 #include "agent/controller.hpp"
-#include "agent/evaluation.hpp"
 #include "agent/pid_controller.hpp"
 #include "common/nn/mlp.hpp"
+#include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace auvrl::agent {
@@ -148,22 +148,22 @@ TEST(PidController, RejectsBadGainsAndVehiclesWithoutAuthority) {
 
 /// Test 1 with the PID: the full 70 s, trajectory recorded.
 struct PidRun {
-  SummaryRow row;
+  eval::SummaryRow row;
   std::vector<TrajectoryRow> trajectory;
 };
 
-PidRun run_pid(Scenario scenario) {
+PidRun run_pid(eval::Scenario scenario) {
   PidController pid(nessie());
-  EvaluationConfig config;
+  eval::EvaluationConfig config;
   config.task.num_thrusters = nessie().num_thrusters();
   PidRun r;
-  r.row = run_evaluation_episode(nessie(), config, pid, scenario_episodes(config, scenario)[0],
-                                 &r.trajectory);
+  r.row = eval::run_evaluation_episode(nessie(), config, pid,
+                                       eval::scenario_episodes(config, scenario)[0], &r.trajectory);
   return r;
 }
 
 TEST(PidController, ReachesTest1WellInside70sAndHoldsStation) {
-  const PidRun r = run_pid(Scenario::kTest1);
+  const PidRun r = run_pid(eval::Scenario::kTest1);
   ASSERT_TRUE(r.row.reached);
   EXPECT_LT(r.row.time_to_reach_s, 20.0);           // measured 8.3 s
   EXPECT_EQ(r.trajectory.size(), 701u);             // the full 70 s: it did not stop on arrival
@@ -179,17 +179,18 @@ TEST(PidController, ReachesTest1WellInside70sAndHoldsStation) {
 }
 
 TEST(PidController, ReachesTest2AndTheFaultAndTheCurrentCase) {
-  for (Scenario s : {Scenario::kTest2, Scenario::kFault, Scenario::kCurrent}) {
+  for (eval::Scenario s :
+       {eval::Scenario::kTest2, eval::Scenario::kFault, eval::Scenario::kCurrent}) {
     const PidRun r = run_pid(s);
-    EXPECT_TRUE(r.row.reached) << to_string(s);
-    EXPECT_LT(r.row.time_to_reach_s, 30.0) << to_string(s);  // measured 8.5-11.6 s
-    EXPECT_LT(r.row.final_error_m, 0.25) << to_string(s);
-    EXPECT_EQ(r.row.end_reason, task::EndReason::kReached) << to_string(s);
+    EXPECT_TRUE(r.row.reached) << eval::to_string(s);
+    EXPECT_LT(r.row.time_to_reach_s, 30.0) << eval::to_string(s);  // measured 8.5-11.6 s
+    EXPECT_LT(r.row.final_error_m, 0.25) << eval::to_string(s);
+    EXPECT_EQ(r.row.end_reason, task::EndReason::kReached) << eval::to_string(s);
   }
 }
 
 TEST(PidController, TurnsBeforeDrivingWhenFacingAway) {
-  const PidRun r = run_pid(Scenario::kTest2);
+  const PidRun r = run_pid(eval::Scenario::kTest2);
   // During the first two seconds it turns (and heaves) but does not drive forward or back.
   for (const TrajectoryRow& row : r.trajectory) {
     if (row.time_s > 2.0) break;

@@ -11,10 +11,10 @@
 #include <sstream>
 #include <thread>
 
-#include "agent/evaluation.hpp"
 #include "child_process.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
+#include "eval/evaluation.hpp"
 #include "run_files.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -191,11 +191,11 @@ TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
   nn::Mlp untrained(trained.spec(), 1);
   nn::Rng rng(99);
   untrained.init_lillicrap(rng);
-  agent::EvaluationConfig config;
-  config.task.layout = agent::infer_layout(trained.spec().input_dim, 6);
+  eval::EvaluationConfig config;
+  config.task.layout = eval::infer_layout(trained.spec().input_dim, 6);
   agent::PolicyController controller(untrained, config.task.state_dim(), 6);
   const auto baseline =
-      agent::run_evaluation(model, config, controller, {agent::Scenario::kSuite}, "");
+      eval::run_evaluation(model, config, controller, {eval::Scenario::kSuite}, "");
   int baseline_reached = 0;
   double baseline_error = 0;
   for (const auto& r : baseline) {

@@ -12,7 +12,7 @@
 
 #include "sim/vehicle_model.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::test_support {
 
 /// A scratch directory for one test, removed at the end.
 class TempDir {
@@ -66,4 +66,4 @@ inline std::vector<std::vector<std::string>> read_csv(const std::string& path) {
   return rows;
 }
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::test_support

@@ -12,14 +12,19 @@
 #include <utility>
 #include <vector>
 
-#include "agent/evaluation.hpp"
 #include "agent/pid_controller.hpp"
 #include "agent_test_util.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
+#include "eval/evaluation.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::eval {
 namespace {
+
+using test_support::nessie;
+using test_support::read_csv;
+using test_support::TempDir;
+using test_support::vehicle_path;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -92,7 +97,7 @@ TEST(Evaluation, WritesSummaryAndTrajectoriesWithTheRightColumns) {
   EvaluationConfig c;
   c.suite_episodes = 3;
   c.suite_trajectories = 2;
-  PidController pid(nessie());
+  agent::PidController pid(nessie());
   const std::vector<SummaryRow> rows = run_evaluation(
       nessie(), c, pid, {Scenario::kTest1, Scenario::kFault, Scenario::kSuite}, dir.path("out"));
   ASSERT_EQ(rows.size(), 5u);
@@ -184,7 +189,7 @@ TEST(Evaluation, EpisodesRunTheEvaluationLengthNotTheTrainingOne) {
   TempDir dir;
   EvaluationConfig c;
   c.task.max_steps = 50;  // a short training episode
-  PidController pid(nessie());
+  agent::PidController pid(nessie());
   run_evaluation(nessie(), c, pid, {Scenario::kTest1}, dir.path("out"));
   const auto trajectory = read_csv(dir.path("out/trajectories/test1_0.csv"));
   EXPECT_EQ(trajectory.size(), 1u + 1u + 700u);  // header, the reset state, 700 steps
@@ -194,7 +199,7 @@ TEST(Evaluation, EpisodesRunTheEvaluationLengthNotTheTrainingOne) {
 }
 
 TEST(Evaluation, SummaryTableHasOneLinePerScenario) {
-  PidController pid(nessie());
+  agent::PidController pid(nessie());
   EvaluationConfig c;
   c.suite_episodes = 2;
   const std::vector<SummaryRow> rows =
@@ -439,4 +444,4 @@ TEST(EvalCommand, TheCommittedPolicyPassesThePapersTests) {
 }
 
 }  // namespace
-}  // namespace auvrl::agent
+}  // namespace auvrl::eval

@@ -1,4 +1,4 @@
-#include "agent/launcher.hpp"
+#include "launcher/launcher.hpp"
 
 #include <signal.h>
 #include <unistd.h>
@@ -24,9 +24,7 @@
 #include <random>
 #include <sstream>
 
-#include "agent/evaluation.hpp"
 #include "agent/pid_controller.hpp"
-#include "agent/policy_finetune.hpp"
 #include "common/channels.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/nn/file_io.hpp"
@@ -36,77 +34,18 @@
 #include "common/task/task_yaml.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
+#include "eval/evaluation.hpp"
+#include "eval/quick_evaluator.hpp"
+#include "launcher/run_config.hpp"
 #include "sim/vehicle_model.hpp"
+#include "tuning/policy_finetune.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::launcher {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-/// Everything the launcher reads from the run configuration.
-struct RunConfig {
-  RunSettings run;
-  task::TaskConfig task;
-  std::string vehicle_path;
-  std::int64_t learner_max_episodes = 0;
-  transport::TransportConfig transport;  ///< the `transport:` section (LCM by default)
-  FinetuneConfig finetune;               ///< the `finetune:` section (off by default)
-};
-
-RunConfig read_run_config(const std::string& path) {
-  RunConfig c;
-  config::Section root = config::load_file(path);
-  std::string vehicle = "../vehicles/nessie7.yaml";
-  root.read("vehicle", vehicle);
-  c.vehicle_path = config::resolve_path(root, vehicle);
-  task::read_task_config(root.child("task"), c.task);
-  config::Section learner = root.child("learner");
-  learner.read("max_episodes", c.learner_max_episodes);
-  config::Section run = root.child("run");
-  run.read("actors", c.run.actors);
-  run.read("seed", c.run.seed);
-  run.read("max_train_s", c.run.max_train_s);
-  run.read("best_eval_period_s", c.run.best_eval_period_s);
-  run.read("best_eval_suite", c.run.best_eval_suite);
-  run.read("best_eval_max_hold_m", c.run.best_eval_max_hold_m);
-  if (!(c.run.best_eval_max_hold_m > 0.0)) {
-    run.fail("best_eval_max_hold_m", "expected a hold error in metres greater than 0");
-  }
-  run.read("learner_cpu", c.run.learner_cpu);
-  run.read("private_lockstep_bus", c.run.private_lockstep_bus);
-  run.read("max_restarts", c.run.max_restarts);
-  run.read("restart_window_s", c.run.restart_window_s);
-  run.read("heartbeat_timeout_s", c.run.heartbeat_timeout_s);
-  run.finish();
-  transport::read_transport_section(root.child("transport"), c.transport);
-  config::Section finetune = root.child("finetune");
-  finetune.read("iterations", c.finetune.iterations);
-  finetune.read("pairs", c.finetune.pairs);
-  finetune.read("sigma", c.finetune.sigma);
-  finetune.read("learning_rate", c.finetune.learning_rate);
-  finetune.read("episodes", c.finetune.episodes);
-  finetune.read("random_heading_fraction", c.finetune.random_heading_fraction);
-  finetune.read("hold_weight", c.finetune.hold_weight);
-  finetune.read("hold_steps", c.finetune.hold_steps);
-  finetune.read("flip_margin_rad", c.finetune.flip_margin_rad);
-  finetune.read("flip_margin_weight", c.finetune.flip_margin_weight);
-  finetune.read("episode_steps", c.finetune.episode_steps);
-  finetune.read("pid_lag_weight", c.finetune.pid_lag_weight);
-  finetune.read("pid_lead_s", c.finetune.pid_lead_s);
-  finetune.read("integration_substeps", c.finetune.integration_substeps);
-  finetune.read("threads", c.finetune.threads);
-  finetune.finish();
-  try {
-    c.finetune.validate();
-  } catch (const std::invalid_argument& e) {
-    // "finetune: KEY must be ...": name the key, its file and line.
-    const std::string what = std::string(e.what()).substr(std::string("finetune: ").size());
-    finetune.fail(what.substr(0, what.find(' ')), what);
-  }
-  return c;
-}
 
 std::string timestamp() {
   const std::time_t now = std::time(nullptr);
@@ -131,56 +70,6 @@ struct Role {
   bool waiting_restart = false;
   bool finished = false;  ///< ended by itself, successfully, and should stay ended
   int actor_id = -1;      ///< an actor's id (its signs of life are its EPISODE reports)
-};
-
-/// Seed of the quick evaluation's way-points (the reported suite uses seed 1).
-constexpr std::uint64_t kValidationSeed = 0x7A11DA7E;
-
-/// The quick evaluation that keeps the best policy: the validation way-points, run once by the
-/// PID baseline at construction and by each candidate policy on demand. With turned > 0, that
-/// many more way-points start facing a random heading (as test2 does; the fine-tuning's
-/// choice, which must not trade the turn for speed).
-class QuickEvaluator {
- public:
-  QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task, int suite_episodes,
-                 int turned = 0)
-      : model_(model), task_(task) {
-    config_.task = task;
-    apply_vehicle(model, config_.task);
-    config_.suite_episodes = suite_episodes + turned;
-    // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
-    // and the suite's seed 1) must not be the ones that choose the policy, or the reported
-    // times would be the best of many draws on the very tests.
-    config_.seed = kValidationSeed;
-    episodes_ = scenario_episodes(config_, Scenario::kSuite);
-    std::mt19937_64 rng(kValidationSeed + 1);
-    for (int i = suite_episodes; i < suite_episodes + turned; ++i) {
-      episodes_[static_cast<std::size_t>(i)].start.euler_rpy_rad[2] =
-          (2.0 * task::unit_draw(rng) - 1.0) * 3.14159265358979323846;
-    }
-    PidController pid(model_);
-    reference_ = run(pid);
-  }
-
-  ValidationScore evaluate(const nn::Mlp& network) const {
-    PolicyController controller(network, task_.state_dim(), task_.num_thrusters);
-    return score_against_reference(run(controller), reference_);
-  }
-
- private:
-  std::vector<SummaryRow> run(Controller& controller) const {
-    std::vector<SummaryRow> rows;
-    for (const EvaluationEpisode& e : episodes_) {
-      rows.push_back(run_evaluation_episode(model_, config_, controller, e, nullptr));
-    }
-    return rows;
-  }
-
-  const sim::VehicleModel& model_;
-  task::TaskConfig task_;
-  EvaluationConfig config_;
-  std::vector<EvaluationEpisode> episodes_;
-  std::vector<SummaryRow> reference_;
 };
 
 /// Whether dir holds a finished learner checkpoint (checkpoint-<updates>.ckpt). A learner
@@ -261,19 +150,6 @@ std::string prepare_run_directory(TrainOptions& o) {
 
 namespace {
 
-/// How the fine-tuning's weights are ranked on the validation way-points: more reached, then
-/// a mean hold error within max_hold_m (or, both outside, the smaller), then the shorter mean
-/// time: what the fine-tuning lowers. (The training's own ranking puts the worst time ratio to
-/// the PID before the mean time; over one way-point of 40 it moves +-0.1-0.2 between
-/// neighbouring iterations and would turn down a second off the mean.)
-bool finetune_better(const ValidationScore& a, const ValidationScore& b, double max_hold_m) {
-  if (a.reached != b.reached) return a.reached > b.reached;
-  const bool a_holds = a.mean_hold_m <= max_hold_m, b_holds = b.mean_hold_m <= max_hold_m;
-  if (a_holds != b_holds) return a_holds;
-  if (!a_holds && a.mean_hold_m != b.mean_hold_m) return a.mean_hold_m < b.mean_hold_m;
-  return a.mean_time_s < b.mean_time_s;
-}
-
 /// Fine-tunes the trained policy at start_path (progress to finetune.csv) and returns the path
 /// of the policy to keep. The weights are scored on validation way-points (the quick
 /// evaluation's, and half as many again facing a random heading) every validate_every
@@ -282,8 +158,8 @@ bool finetune_better(const ValidationScore& a, const ValidationScore& b, double 
 /// fine-tuning's own way-points are few: a step that lowers their objective can lose a
 /// way-point elsewhere.) Ctrl-C ends the fine-tuning after the iteration under way.
 std::string finetune_stage(const sim::VehicleModel& model, const task::TaskConfig& task,
-                           const FinetuneConfig& config, std::uint64_t seed,
-                           const QuickEvaluator& quick, double max_hold_m,
+                           const tuning::FinetuneConfig& config, std::uint64_t seed,
+                           const eval::QuickEvaluator& quick, double max_hold_m,
                            const std::string& start_path, const fs::path& run_dir,
                            std::ostream& out) {
   constexpr int validate_every = 10;
@@ -291,30 +167,30 @@ std::string finetune_stage(const sim::VehicleModel& model, const task::TaskConfi
   out << "auvrl train: fine-tuning " << start_path << " (evolution strategies, "
       << config.iterations << " iterations of " << 2 * config.pairs << " policies on "
       << config.episodes << " way-points)\n";
-  auto describe = [](const ValidationScore& v) {
+  auto describe = [](const eval::ValidationScore& v) {
     std::ostringstream text;
     text << v.reached << "/" << v.episodes << " reached, mean " << std::fixed
          << std::setprecision(2) << v.mean_time_s << " s, hold " << v.mean_hold_m
          << " m, worst time ratio to the PID " << v.max_time_ratio;
     return text.str();
   };
-  const ValidationScore before = quick.evaluate(start);
-  ValidationScore best = before;
+  const eval::ValidationScore before = quick.evaluate(start);
+  eval::ValidationScore best = before;
   std::optional<nn::Mlp> best_net;
   int best_iteration = 0;
   const std::string csv_path = (run_dir / "finetune.csv").string();
   std::ofstream csv(csv_path);
   csv << "iteration,objective_s,elapsed_s,validation_reached,validation_mean_time_s,"
          "validation_hold_m,validation_worst_time_ratio\n";
-  const FinetuneResult result = finetune_policy(
+  const tuning::FinetuneResult result = tuning::finetune_policy(
       model, task, start, config, seed,
-      [&](const FinetuneIteration& it, const nn::Mlp& weights) {
+      [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
         csv << it.iteration << ',' << it.objective << ',' << it.elapsed_s;
         if (it.iteration % validate_every == 0 || it.iteration == config.iterations) {
-          const ValidationScore score = quick.evaluate(weights);
+          const eval::ValidationScore score = quick.evaluate(weights);
           csv << ',' << score.reached << ',' << score.mean_time_s << ',' << score.mean_hold_m << ','
               << score.max_time_ratio;
-          if (finetune_better(score, best, max_hold_m)) {
+          if (eval::finetune_better(score, best, max_hold_m)) {
             best = score;
             best_net = weights;
             best_iteration = it.iteration;
@@ -578,9 +454,9 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   auto next_best_eval =
       Clock::now() + std::chrono::duration_cast<Clock::duration>(
                          std::chrono::duration<double>(rc.run.best_eval_period_s));
-  const QuickEvaluator quick(model, rc.task, rc.run.best_eval_suite);
+  const eval::QuickEvaluator quick(model, rc.task, rc.run.best_eval_suite);
   const double max_hold_m = rc.run.best_eval_max_hold_m;
-  ValidationScore best;
+  eval::ValidationScore best;
   std::int64_t best_version = -1;
   if (options.resume && fs::exists(run_dir / "policy_best.nn")) {
     // A resumed run keeps its best policy unless a newer one scores better.
@@ -707,7 +583,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
         try {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
-          const ValidationScore score = quick.evaluate(net);
+          const eval::ValidationScore score = quick.evaluate(net);
           const bool keep = best_version < 0 || score.better_than(best, max_hold_m);
           if (keep) {
             best = score;
@@ -719,8 +595,9 @@ int run_training(const TrainOptions& options, std::ostream& out) {
                          << (score.reached > 0 ? score.mean_time_s : 0.0) << ','
                          << std::setprecision(3) << (score.reached > 0 ? score.mean_hold_m : 0.0)
                          << ','
-                         << (score.max_time_ratio < ValidationScore::kNone ? score.max_time_ratio
-                                                                           : 0.0)
+                         << (score.max_time_ratio < eval::ValidationScore::kNone
+                                 ? score.max_time_ratio
+                                 : 0.0)
                          << ',' << (keep ? 1 : 0) << '\n';
           quick_eval_csv.flush();
         } catch (const std::exception& e) {
@@ -834,10 +711,10 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     return 1;
   }
 
-  // ---- Fine-tuning on the evaluation's criterion (agent/policy_finetune.hpp). ----
+  // ---- Fine-tuning on the evaluation's criterion (tuning/policy_finetune.hpp). ----
   if (rc.finetune.iterations > 0) {
-    const QuickEvaluator finetune_quick(model, rc.task, rc.run.best_eval_suite,
-                                        rc.run.best_eval_suite / 2);
+    const eval::QuickEvaluator finetune_quick(model, rc.task, rc.run.best_eval_suite,
+                                              rc.run.best_eval_suite / 2);
     try {
       policy_path = finetune_stage(model, rc.task, rc.finetune, rc.run.seed, finetune_quick,
                                    max_hold_m, policy_path, run_dir, out);
@@ -850,19 +727,19 @@ int run_training(const TrainOptions& options, std::ostream& out) {
 
   // ---- Evaluation of the learned policy and the PID baseline, plots, report. ----
   out << "auvrl train: evaluating " << policy_path << " and the PID baseline\n";
-  EvaluationConfig eval;
+  eval::EvaluationConfig eval;
   eval.task = rc.task;
-  const std::vector<Scenario> all = parse_scenarios("all");
+  const std::vector<eval::Scenario> all = eval::parse_scenarios("all");
   const nn::Mlp policy_net = nn::network_from_bytes(nn::read_file(policy_path), 1);
-  PolicyController policy(policy_net, rc.task.state_dim(), rc.task.num_thrusters);
+  agent::PolicyController policy(policy_net, rc.task.state_dim(), rc.task.num_thrusters);
   const auto policy_rows =
-      run_evaluation(model, eval, policy, all, (run_dir / "eval" / "policy").string());
-  EvalRequest pid_request;
+      eval::run_evaluation(model, eval, policy, all, (run_dir / "eval" / "policy").string());
+  eval::EvalRequest pid_request;
   pid_request.controller = "pid";
-  EvaluationConfig pid_eval = eval;
-  auto pid = make_eval_controller(pid_request, model, pid_eval);
+  eval::EvaluationConfig pid_eval = eval;
+  auto pid = eval::make_eval_controller(pid_request, model, pid_eval);
   const auto pid_rows =
-      run_evaluation(model, pid_eval, *pid, all, (run_dir / "eval" / "pid").string());
+      eval::run_evaluation(model, pid_eval, *pid, all, (run_dir / "eval" / "pid").string());
   std::ofstream(run_dir / "eval" / "selected_policy.txt") << policy_path << "\n";
 
   const std::string plot = options.source_dir + "/scripts/plot_run.py";
@@ -873,9 +750,10 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     if (status != 0) out << "auvrl train: plotting failed (see " << plotter.log_path() << ")\n";
   }
   out << "\nlearned policy (" << policy_path << "):\n"
-      << format_summary_table(policy_rows) << "\nPID baseline:\n"
-      << format_summary_table(pid_rows) << "\nreport: " << (run_dir / "report.md").string() << "\n";
+      << eval::format_summary_table(policy_rows) << "\nPID baseline:\n"
+      << eval::format_summary_table(pid_rows) << "\nreport: " << (run_dir / "report.md").string()
+      << "\n";
   return 0;
 }
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::launcher

@@ -10,24 +10,29 @@
 #include <string>
 #include <vector>
 
-#include "agent/arrival_search.hpp"
 #include "agent/pid_controller.hpp"
 #include "agent_test_util.hpp"
 #include "sim/open_loop.hpp"
+#include "tools/arrival_search.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tools {
 namespace {
 
-EvaluationConfig test_config() {
-  EvaluationConfig c;
+using test_support::nessie;
+using test_support::read_csv;
+using test_support::TempDir;
+using test_support::vehicle_path;
+
+eval::EvaluationConfig test_config() {
+  eval::EvaluationConfig c;
   c.task.num_thrusters = nessie().num_thrusters();
   c.task.max_thrust_n = nessie().thruster_dynamics.max_thrust_n;
   c.task.control_step_s = nessie().control_step_s;
   return c;
 }
 
-EvaluationEpisode test1(const EvaluationConfig& c) {
-  return scenario_episodes(c, Scenario::kTest1).front();
+eval::EvaluationEpisode test1(const eval::EvaluationConfig& c) {
+  return eval::scenario_episodes(c, eval::Scenario::kTest1).front();
 }
 
 ArrivalSearchConfig small_search(int iterations) {
@@ -39,11 +44,12 @@ ArrivalSearchConfig small_search(int iterations) {
 }
 
 TEST(ArrivalSearch, StartsFromThePidAndNeverEndsLater) {
-  const EvaluationConfig config = test_config();
+  const eval::EvaluationConfig config = test_config();
   const ArrivalSearchResult r =
       search_fastest_arrival(nessie(), config, test1(config), small_search(10));
-  PidController pid(nessie());
-  const SummaryRow pid_row = run_evaluation_episode(nessie(), config, pid, test1(config), nullptr);
+  agent::PidController pid(nessie());
+  const eval::SummaryRow pid_row =
+      eval::run_evaluation_episode(nessie(), config, pid, test1(config), nullptr);
   ASSERT_TRUE(pid_row.reached);
   EXPECT_EQ(r.pid_arrival_step, static_cast<int>(std::lround(pid_row.time_to_reach_s / 0.1)));
   ASSERT_GT(r.start_arrival_step, 0) << "the PID's commands, replayed, arrive too";
@@ -62,7 +68,7 @@ TEST(ArrivalSearch, StartsFromThePidAndNeverEndsLater) {
 }
 
 TEST(ArrivalSearch, TheSameSeedGivesTheSameCommands) {
-  const EvaluationConfig config = test_config();
+  const eval::EvaluationConfig config = test_config();
   const ArrivalSearchResult a =
       search_fastest_arrival(nessie(), config, test1(config), small_search(5));
   const ArrivalSearchResult b =
@@ -76,7 +82,7 @@ TEST(ArrivalSearch, TheSameSeedGivesTheSameCommands) {
 // within a few thousand rollouts (and the evaluation, with the PID holding after the
 // commands, measures the same arrival time).
 TEST(ArrivalSearch, FindsASoonerArrivalThanThePidOnTest1) {
-  const EvaluationConfig config = test_config();
+  const eval::EvaluationConfig config = test_config();
   ArrivalSearchConfig search = small_search(80);
   search.population = 100;
   search.elites = 10;
@@ -84,16 +90,17 @@ TEST(ArrivalSearch, FindsASoonerArrivalThanThePidOnTest1) {
   ASSERT_GT(r.best_arrival_step, 0);
   EXPECT_LT(r.best_arrival_step, r.pid_arrival_step);
 
-  OpenLoopController found(r.commands, 6, std::make_unique<PidController>(nessie()));
+  OpenLoopController found(r.commands, 6, std::make_unique<agent::PidController>(nessie()));
   EXPECT_EQ(found.name(), "open_loop+pid");
-  const SummaryRow row = run_evaluation_episode(nessie(), config, found, test1(config), nullptr);
+  const eval::SummaryRow row =
+      eval::run_evaluation_episode(nessie(), config, found, test1(config), nullptr);
   ASSERT_TRUE(row.reached);
   EXPECT_NEAR(row.time_to_reach_s, r.best_arrival_step * 0.1, 1e-9);
   EXPECT_LT(row.mean_error_after_reach_m, 0.3) << "the PID holds station after the arrival";
 }
 
 TEST(ArrivalSearch, AuvSimsOpenLoopToolReplaysTheCommandsToTheSameArrival) {
-  const EvaluationConfig config = test_config();
+  const eval::EvaluationConfig config = test_config();
   const ArrivalSearchResult r =
       search_fastest_arrival(nessie(), config, test1(config), small_search(5));
   ASSERT_GT(r.best_arrival_step, 0);
@@ -120,7 +127,7 @@ TEST(ArrivalSearch, AuvSimsOpenLoopToolReplaysTheCommandsToTheSameArrival) {
 // Arrive and stay: the found commands keep the vehicle within the distance asked for the
 // stay_steps after the arrival (checked by replaying them through auv_sim's open-loop tool).
 TEST(ArrivalSearch, WithStayWithinTheFoundCommandsStopAtTheWayPoint) {
-  const EvaluationConfig config = test_config();
+  const eval::EvaluationConfig config = test_config();
   ArrivalSearchConfig search = small_search(10);
   search.stay_within_m = 0.5;
   search.stay_steps = 30;
@@ -150,7 +157,7 @@ TEST(ArrivalSearch, WithStayWithinTheFoundCommandsStopAtTheWayPoint) {
 }
 
 /// Records what it was asked, and answers a constant.
-class ConstantController final : public Controller {
+class ConstantController final : public agent::Controller {
  public:
   void reset() override { ++resets; }
   void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector&,
@@ -235,8 +242,8 @@ TEST(ArrivalSearch, RefusesBadSettingsByName) {
 }
 
 TEST(ArrivalSearch, SaysSoWhenThePidNeverArrives) {
-  const EvaluationConfig config = test_config();
-  EvaluationEpisode dead = test1(config);
+  const eval::EvaluationConfig config = test_config();
+  eval::EvaluationEpisode dead = test1(config);
   dead.start.thruster_efficiency.assign(6, 0.0);  // no thrust at all
   try {
     search_fastest_arrival(nessie(), config, dead, small_search(1));
@@ -274,4 +281,4 @@ TEST(ArrivalSearch, TheRequestWritesCommandsSummarySearchAndTrajectories) {
 }
 
 }  // namespace
-}  // namespace auvrl::agent
+}  // namespace auvrl::tools

@@ -1,4 +1,4 @@
-#include "agent/evaluation.hpp"
+#include "eval/evaluation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::eval {
 
 namespace {
 
@@ -154,14 +154,14 @@ void apply_vehicle(const sim::VehicleModel& model, task::TaskConfig& task) {
 }
 
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
-                                  Controller& controller, const EvaluationEpisode& episode,
-                                  std::vector<TrajectoryRow>* trajectory) {
-  std::unique_ptr<VehicleLink> link = make_in_process_link(model);
+                                  agent::Controller& controller, const EvaluationEpisode& episode,
+                                  std::vector<agent::TrajectoryRow>* trajectory) {
+  std::unique_ptr<agent::VehicleLink> link = agent::make_in_process_link(model);
   if (trajectory) {
     // The reset state as the first row (run_episode records from the first step on); the
     // in-process link is deterministic, so run_episode's own reset gives the same state.
     trajectory->clear();
-    const std::optional<VehicleReport> first = link->reset(episode.start);
+    const std::optional<agent::VehicleReport> first = link->reset(episode.start);
     if (first) {
       const auto n = static_cast<std::size_t>(model.num_thrusters());
       trajectory->push_back({first->time_s, first->observation, std::vector<double>(n, 0.0),
@@ -169,7 +169,7 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
                              (episode.goal_ned_m - first->observation.position_ned_m).norm()});
     }
   }
-  EpisodeOptions options;
+  agent::EpisodeOptions options;
   options.goal_ned_m = episode.goal_ned_m;
   options.beta_m = config.reach_radius_m;
   options.start = episode.start;
@@ -178,7 +178,7 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   options.trajectory = trajectory;
   task::TaskConfig task = config.task;
   task.max_steps = config.episode_steps;
-  const EpisodeSummary s = run_episode(task, *link, controller, options);
+  const agent::EpisodeSummary s = agent::run_episode(task, *link, controller, options);
 
   SummaryRow row;
   row.scenario = to_string(episode.scenario);
@@ -195,7 +195,7 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
 }
 
 std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, EvaluationConfig config,
-                                       Controller& controller,
+                                       agent::Controller& controller,
                                        const std::vector<Scenario>& scenarios,
                                        const std::string& out_dir) {
   apply_vehicle(model, config.task);
@@ -214,7 +214,7 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
     }
   }
   std::vector<SummaryRow> rows;
-  std::vector<TrajectoryRow> trajectory;
+  std::vector<agent::TrajectoryRow> trajectory;
   for (Scenario scenario : scenarios) {
     for (const EvaluationEpisode& episode : scenario_episodes(config, scenario)) {
       const bool write_trajectory =
@@ -311,12 +311,12 @@ std::string trajectory_csv_header(int num_thrusters) {
   return h + ",distance_m";
 }
 
-void write_trajectory_csv(const std::string& path, const std::vector<TrajectoryRow>& rows,
+void write_trajectory_csv(const std::string& path, const std::vector<agent::TrajectoryRow>& rows,
                           int num_thrusters) {
   std::ofstream out = open_for_writing(path);
   out << trajectory_csv_header(num_thrusters) << '\n';
   const auto n = static_cast<std::size_t>(num_thrusters);
-  for (const TrajectoryRow& r : rows) {
+  for (const agent::TrajectoryRow& r : rows) {
     if (r.thrust_command_n.size() != n || r.thrust_realised_n.size() != n) {
       throw std::invalid_argument(path + ": a trajectory row does not have " +
                                   std::to_string(num_thrusters) + " thrusters");
@@ -395,9 +395,9 @@ task::StateLayout infer_layout(int input_dim, int num_thrusters) {
       std::to_string(kExtendedFixedInputs + 2 * num_thrusters) + " (extended_thrust)");
 }
 
-std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,
-                                                 const sim::VehicleModel& model,
-                                                 EvaluationConfig& config) {
+std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& request,
+                                                        const sim::VehicleModel& model,
+                                                        EvaluationConfig& config) {
   const int n = model.num_thrusters();
   config.task.num_thrusters = n;
   if (!request.layout.empty()) config.task.layout = task::parse_layout(request.layout);
@@ -405,7 +405,7 @@ std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,
     if (!request.policy_path.empty()) {
       throw std::invalid_argument("--policy and --controller pid exclude each other");
     }
-    return std::make_unique<PidController>(model);
+    return std::make_unique<agent::PidController>(model);
   }
   if (request.controller != "policy") {
     throw std::invalid_argument("--controller '" + request.controller +
@@ -437,7 +437,8 @@ std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,
     }
   }
   try {
-    return std::make_unique<PolicyController>(std::move(network), config.task.state_dim(), n);
+    return std::make_unique<agent::PolicyController>(std::move(network), config.task.state_dim(),
+                                                     n);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + " with the " + task::to_string(config.task.layout) +
                              " layout: " + e.what());
@@ -454,7 +455,7 @@ std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostrea
   config.seed = request.seed;
   config.suite_episodes = request.suite_episodes;
   config.suite_trajectories = request.suite_trajectories;
-  std::unique_ptr<Controller> controller = make_eval_controller(request, model, config);
+  std::unique_ptr<agent::Controller> controller = make_eval_controller(request, model, config);
   const std::vector<SummaryRow> rows =
       run_evaluation(model, config, *controller, scenarios, request.out_dir);
   out << format_summary_table(rows);
@@ -463,4 +464,4 @@ std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostrea
   return rows;
 }
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::eval

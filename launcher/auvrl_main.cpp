@@ -1,5 +1,5 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
-// library that does the work (agent/evaluation.hpp for eval, agent/arrival_search.hpp for fastest);
+// library that does the work (eval/evaluation.hpp for eval, tools/arrival_search.hpp for fastest);
 // adding one is adding a row to kSubcommands.
 #include <unistd.h>
 
@@ -10,11 +10,11 @@
 #include <string>
 #include <vector>
 
-#include "agent/arrival_search.hpp"
-#include "agent/evaluation.hpp"
-#include "agent/launcher.hpp"
 #include "common/cli.hpp"
 #include "common/transport_options.hpp"
+#include "eval/evaluation.hpp"
+#include "launcher/launcher.hpp"
+#include "tools/arrival_search.hpp"
 
 namespace {
 
@@ -24,7 +24,7 @@ namespace {
 
 /// `auvrl eval`: a policy file or the PID baseline on the evaluation scenarios.
 int run_eval(int argc, const char* const* argv) {
-  auvrl::agent::EvalRequest request;
+  auvrl::eval::EvalRequest request;
   request.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
   std::int64_t seed = 1;
   auvrl::cli::CommandLine cli(
@@ -48,13 +48,13 @@ int run_eval(int argc, const char* const* argv) {
   if (!cli.parse(argc, argv)) return 0;
   if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
   request.seed = static_cast<std::uint64_t>(seed);
-  auvrl::agent::run_eval_request(request, std::cout);
+  auvrl::eval::run_eval_request(request, std::cout);
   return 0;
 }
 
 /// `auvrl fastest`: how soon the vehicle could reach a scenario's way-point at all.
 int run_fastest(int argc, const char* const* argv) {
-  auvrl::agent::ArrivalSearchRequest request;
+  auvrl::tools::ArrivalSearchRequest request;
   request.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
   std::int64_t seed = 1;
   auvrl::cli::CommandLine cli(
@@ -79,7 +79,7 @@ int run_fastest(int argc, const char* const* argv) {
   if (!cli.parse(argc, argv)) return 0;
   if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
   request.search.seed = static_cast<std::uint64_t>(seed);
-  auvrl::agent::run_arrival_search_request(request, std::cout);
+  auvrl::tools::run_arrival_search_request(request, std::cout);
   return 0;
 }
 
@@ -92,7 +92,7 @@ std::string own_bin_dir() {
 
 /// `auvrl train`: the whole training system, then evaluation, plots and report.
 int run_train(int argc, const char* const* argv) {
-  auvrl::agent::TrainOptions options;
+  auvrl::launcher::TrainOptions options;
   options.source_dir = AUVRL_SOURCE_DIR;
   options.bin_dir = own_bin_dir();
   std::string preset = "fast", network = "private", resume_dir;
@@ -133,12 +133,12 @@ int run_train(int argc, const char* const* argv) {
   }
   const char* inside = std::getenv("AUVRL_IN_NETNS");
   if (network == "host" || (inside != nullptr && std::string(inside) == "1")) {
-    if (inside == nullptr) auvrl::agent::prepare_run_directory(options);
-    return auvrl::agent::run_training(options, std::cout);
+    if (inside == nullptr) auvrl::launcher::prepare_run_directory(options);
+    return auvrl::launcher::run_training(options, std::cout);
   }
   // Prepare the run directory here, then run again inside a private network namespace whose
   // PID file the run directory keeps (lcm-spy and the log tools join it).
-  auvrl::agent::prepare_run_directory(options);
+  auvrl::launcher::prepare_run_directory(options);
   const std::string netns = std::string(AUVRL_SOURCE_DIR) + "/scripts/netns.sh";
   std::vector<std::string> args = {
       netns,      "--pidfile",    options.run_dir + "/netns.pid", own_bin_dir() + "/auvrl", "train",

@@ -40,7 +40,7 @@
 #include "common/task/task.hpp"
 #include "sim/vehicle_model.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::eval {
 
 /// One evaluation scenario (see the file comment).
 enum class Scenario { kTest1, kTest2, kFault, kCurrent, kSuite };
@@ -74,7 +74,7 @@ struct EvaluationEpisode {
   Scenario scenario = Scenario::kTest1;
   int index = 0;  ///< episode number within the scenario, from 0
   Eigen::Vector3d goal_ned_m = Eigen::Vector3d::Zero();
-  EpisodeStart start;
+  agent::EpisodeStart start;
 };
 
 /// The episodes of a scenario (one for the paper's tests, suite_episodes for the suite).
@@ -105,15 +105,15 @@ void apply_vehicle(const sim::VehicleModel& model, task::TaskConfig& task);
 /// Runs one episode in process; fills `trajectory` (when given) with the reset state first,
 /// then one row per control step.
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
-                                  Controller& controller, const EvaluationEpisode& episode,
-                                  std::vector<TrajectoryRow>* trajectory);
+                                  agent::Controller& controller, const EvaluationEpisode& episode,
+                                  std::vector<agent::TrajectoryRow>* trajectory);
 
 /// Runs the scenarios in order and returns one row per episode. With a non-empty out_dir it
 /// creates it (and out_dir/trajectories) and writes summary.csv and the trajectory files;
 /// throws std::runtime_error naming the path if it cannot. The config's task gets the model's
 /// thruster count and maximum thrust.
 std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, EvaluationConfig config,
-                                       Controller& controller,
+                                       agent::Controller& controller,
                                        const std::vector<Scenario>& scenarios,
                                        const std::string& out_dir);
 
@@ -150,7 +150,7 @@ void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& r
 /// Header line of a trajectory file for n thrusters (no newline).
 std::string trajectory_csv_header(int num_thrusters);
 /// Writes a trajectory file; throws std::runtime_error naming the path on failure.
-void write_trajectory_csv(const std::string& path, const std::vector<TrajectoryRow>& rows,
+void write_trajectory_csv(const std::string& path, const std::vector<agent::TrajectoryRow>& rows,
                           int num_thrusters);
 
 /// One screen of text: per scenario, episodes, reached count, mean time to reach and mean
@@ -177,13 +177,13 @@ struct EvalRequest {
 
 /// Builds the controller for a request: loads and checks the policy file (errors name the
 /// file and what was expected) or builds the PID from the model; sets config.task.layout.
-std::unique_ptr<Controller> make_eval_controller(const EvalRequest& request,
-                                                 const sim::VehicleModel& model,
-                                                 EvaluationConfig& config);
+std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& request,
+                                                        const sim::VehicleModel& model,
+                                                        EvaluationConfig& config);
 
 /// The whole `auvrl eval`: loads the vehicle, builds the controller, runs the scenarios,
 /// writes DIR, prints the table to `out`, returns the rows. Throws std::invalid_argument for a
 /// bad request and std::runtime_error for unreadable or unusable files.
 std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostream& out);
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::eval

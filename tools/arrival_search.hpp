@@ -19,7 +19,7 @@
 //                    default (at rest at [0, 0, 5], facing north, no fault or current),
 //                    `auv_sim --vehicle FILE --open-loop commands.csv --out OUT.csv` replays
 //                    them;
-//   summary.csv      the evaluation's summary rows (agent/evaluation.hpp) of the PID and of
+//   summary.csv      the evaluation's summary rows (eval/evaluation.hpp) of the PID and of
 //                    the found commands with the PID taking over on arrival (so the hold error
 //                    after such an arrival is measured too), controller "open_loop+pid";
 //   trajectories/<controller>_<scenario>.csv   both runs, in the evaluation's trajectory format;
@@ -35,10 +35,10 @@
 #include <vector>
 
 #include "agent/controller.hpp"
-#include "agent/evaluation.hpp"
+#include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tools {
 
 /// Settings of the cross-entropy search. Commands are normalised ([-1, 1] of maximum thrust)
 /// and piecewise constant over segments of steps_per_segment control steps.
@@ -88,17 +88,17 @@ struct ArrivalSearchResult {
 /// horizon); throws std::runtime_error otherwise. progress (may be empty) is called after each
 /// iteration with the iteration and the best step so far.
 ArrivalSearchResult search_fastest_arrival(
-    const sim::VehicleModel& model, const EvaluationConfig& config,
-    const EvaluationEpisode& episode, const ArrivalSearchConfig& search,
+    const sim::VehicleModel& model, const eval::EvaluationConfig& config,
+    const eval::EvaluationEpisode& episode, const ArrivalSearchConfig& search,
     const std::function<void(int iteration, int best_step)>& progress = {});
 
 /// Plays fixed commands, one per control step, then hands over to another controller (the
 /// PID baseline: the vehicle holds station after an open-loop arrival).
-class OpenLoopController final : public Controller {
+class OpenLoopController final : public agent::Controller {
  public:
   /// Throws std::invalid_argument if a command is not of size num_thrusters or after is null.
   OpenLoopController(std::vector<Eigen::VectorXd> commands, int num_thrusters,
-                     std::unique_ptr<Controller> after);
+                     std::unique_ptr<agent::Controller> after);
   void reset() override;
   void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
            const task::StateVector& state, task::ActionVector& action) override;
@@ -107,7 +107,7 @@ class OpenLoopController final : public Controller {
  private:
   std::vector<Eigen::VectorXd> commands_;
   int num_thrusters_;
-  std::unique_ptr<Controller> after_;
+  std::unique_ptr<agent::Controller> after_;
   std::size_t next_ = 0;
 };
 
@@ -133,4 +133,4 @@ struct ArrivalSearchRequest {
 ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& request,
                                                std::ostream& out);
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::tools

@@ -1,4 +1,4 @@
-#include "agent/policy_finetune.hpp"
+#include "tuning/policy_finetune.hpp"
 
 #include <unistd.h>
 
@@ -17,7 +17,7 @@
 #include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tuning {
 
 void FinetuneConfig::validate() const {
   auto require = [](bool ok, const std::string& what) {
@@ -75,36 +75,36 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
   arrival_only.hold_weight = 0.0;
   arrival_only.flip_margin_weight = 0.0;
   arrival_only.pid_lag_weight = 0.0;
-  PidController pid(model);
+  agent::PidController pid(model);
   for (FinetuneEpisode& e : episodes) {
     e.pid_arrival_s = arrival_objective(model, task, pid, e, arrival_only);
   }
 }
 
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
-                         Controller& controller, const FinetuneEpisode& episode,
+                         agent::Controller& controller, const FinetuneEpisode& episode,
                          const FinetuneConfig& config, double reach_radius_m) {
   sim::VehicleModel plant = model;
   if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
-  apply_vehicle(plant, t);
+  eval::apply_vehicle(plant, t);
   t.max_steps = config.episode_steps;
-  // The evaluation's episode (agent/evaluation.cpp), ended hold_steps after the arrival.
-  EpisodeOptions options;
+  // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
+  agent::EpisodeOptions options;
   options.goal_ned_m = episode.goal_ned_m;
   options.beta_m = reach_radius_m;
   options.start = episode.start;
   options.reach_radius_m = reach_radius_m;
   options.run_full_time = true;
   options.steps_after_reach = config.hold_steps;
-  std::vector<TrajectoryRow> trajectory;
+  std::vector<agent::TrajectoryRow> trajectory;
   options.trajectory = &trajectory;
-  std::unique_ptr<VehicleLink> link = make_in_process_link(plant);
-  run_episode(t, *link, controller, options);
+  std::unique_ptr<agent::VehicleLink> link = agent::make_in_process_link(plant);
+  agent::run_episode(t, *link, controller, options);
 
   const double dt = plant.control_step_s;
   double tilt_rad = 0.0;
-  for (const TrajectoryRow& row : trajectory) {
+  for (const agent::TrajectoryRow& row : trajectory) {
     tilt_rad = std::max({tilt_rad, std::abs(row.observation.euler_rpy_rad[0]),
                          std::abs(row.observation.euler_rpy_rad[1])});
   }
@@ -146,7 +146,7 @@ FinetuneResult finetune_policy(
   const int n = model.num_thrusters();
   const int state_dim = task.state_dim();
   // Throws if the network does not fit the task.
-  { PolicyController check(start, state_dim, n); }
+  { agent::PolicyController check(start, state_dim, n); }
   std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
   if (config.pid_lag_weight > 0) set_pid_arrivals(model, task, config, episodes);
   const auto t0 = std::chrono::steady_clock::now();
@@ -154,12 +154,12 @@ FinetuneResult finetune_policy(
   int threads = config.threads > 0 ? config.threads
                                    : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   threads = std::min(threads, 2 * config.pairs);
-  std::vector<PolicyController> workers;
+  std::vector<agent::PolicyController> workers;
   for (int w = 0; w < threads; ++w) workers.emplace_back(start, state_dim, n);
   nn::Mlp scratch = start;
 
   // Mean objective of weights theta, with controller c (its network replaced).
-  auto objective = [&](PolicyController& c, const Eigen::VectorXf& theta) {
+  auto objective = [&](agent::PolicyController& c, const Eigen::VectorXf& theta) {
     scratch = c.network();
     scratch.params() = theta;
     c.set_network(scratch);
@@ -194,7 +194,7 @@ FinetuneResult finetune_policy(
       for (int s = w; s < samples; s += threads) {
         const Eigen::VectorXf& eps = noise[static_cast<std::size_t>(s / 2)];
         const float sign = s % 2 == 0 ? 1.0f : -1.0f;
-        PolicyController& c = workers[static_cast<std::size_t>(w)];
+        agent::PolicyController& c = workers[static_cast<std::size_t>(w)];
         nn::Mlp net = c.network();
         net.params() = theta + sign * static_cast<float>(config.sigma) * eps;
         c.set_network(std::move(net));
@@ -255,4 +255,4 @@ FinetuneResult finetune_policy(
   return result;
 }
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::tuning

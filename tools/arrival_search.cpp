@@ -1,4 +1,4 @@
-#include "agent/arrival_search.hpp"
+#include "tools/arrival_search.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +14,7 @@
 #include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tools {
 
 void ArrivalSearchConfig::validate() const {
   auto require = [](bool ok, const std::string& what) {
@@ -36,14 +36,14 @@ void ArrivalSearchConfig::validate() const {
 namespace {
 
 /// The evaluation's config as run_evaluation completes it from the model.
-EvaluationConfig completed(EvaluationConfig config, const sim::VehicleModel& model) {
-  apply_vehicle(model, config.task);
+eval::EvaluationConfig completed(eval::EvaluationConfig config, const sim::VehicleModel& model) {
+  eval::apply_vehicle(model, config.task);
   config.task.max_steps = config.episode_steps;
   config.task.validate();
   return config;
 }
 
-int arrival_step(const SummaryRow& row, double control_step_s) {
+int arrival_step(const eval::SummaryRow& row, double control_step_s) {
   return row.reached ? static_cast<int>(std::lround(row.time_to_reach_s / control_step_s)) : -1;
 }
 
@@ -58,9 +58,9 @@ struct Rollout {
 
 class RolloutRunner {
  public:
-  RolloutRunner(const sim::VehicleModel& model, const EvaluationConfig& config,
-                const EvaluationEpisode& episode, int steps_per_segment)
-      : link_(make_in_process_link(model)),
+  RolloutRunner(const sim::VehicleModel& model, const eval::EvaluationConfig& config,
+                const eval::EvaluationEpisode& episode, int steps_per_segment)
+      : link_(agent::make_in_process_link(model)),
         episode_(episode),
         radius_m_(config.reach_radius_m),
         max_thrust_n_(config.task.max_thrust_n),
@@ -70,7 +70,7 @@ class RolloutRunner {
   /// Runs to the arrival, then stay_steps more (0: stops on arrival).
   Rollout run(const Eigen::MatrixXd& segments, int horizon_steps, int stay_steps) {
     Rollout r;
-    std::optional<VehicleReport> report = link_->reset(episode_.start);
+    std::optional<agent::VehicleReport> report = link_->reset(episode_.start);
     if (!report) throw std::runtime_error("arrival search: the in-process vehicle did not reset");
     r.closest_m = (episode_.goal_ned_m - report->observation.position_ned_m).norm();
     for (int t = 1; t <= horizon_steps + stay_steps; ++t) {
@@ -103,8 +103,8 @@ class RolloutRunner {
   }
 
  private:
-  std::unique_ptr<VehicleLink> link_;
-  EvaluationEpisode episode_;
+  std::unique_ptr<agent::VehicleLink> link_;
+  eval::EvaluationEpisode episode_;
   double radius_m_;
   double max_thrust_n_;
   int steps_per_segment_;
@@ -127,18 +127,19 @@ double cost(const Rollout& r, int horizon_steps, double radius_m, double stay_wi
 }  // namespace
 
 ArrivalSearchResult search_fastest_arrival(
-    const sim::VehicleModel& model, const EvaluationConfig& config_in,
-    const EvaluationEpisode& episode, const ArrivalSearchConfig& search,
+    const sim::VehicleModel& model, const eval::EvaluationConfig& config_in,
+    const eval::EvaluationEpisode& episode, const ArrivalSearchConfig& search,
     const std::function<void(int iteration, int best_step)>& progress) {
   search.validate();
-  const EvaluationConfig config = completed(config_in, model);
+  const eval::EvaluationConfig config = completed(config_in, model);
   const int n = model.num_thrusters();
   const double dt = config.task.control_step_s;
 
   ArrivalSearchResult result;
-  PidController pid(model);
-  std::vector<TrajectoryRow> pid_trajectory;
-  const SummaryRow pid_row = run_evaluation_episode(model, config, pid, episode, &pid_trajectory);
+  agent::PidController pid(model);
+  std::vector<agent::TrajectoryRow> pid_trajectory;
+  const eval::SummaryRow pid_row =
+      eval::run_evaluation_episode(model, config, pid, episode, &pid_trajectory);
   result.pid_arrival_step = arrival_step(pid_row, dt);
   if (result.pid_arrival_step < 0) {
     throw std::runtime_error(std::string("arrival search: the PID baseline never reaches the ") +
@@ -242,7 +243,7 @@ ArrivalSearchResult search_fastest_arrival(
 }
 
 OpenLoopController::OpenLoopController(std::vector<Eigen::VectorXd> commands, int num_thrusters,
-                                       std::unique_ptr<Controller> after)
+                                       std::unique_ptr<agent::Controller> after)
     : commands_(std::move(commands)), num_thrusters_(num_thrusters), after_(std::move(after)) {
   if (!after_) throw std::invalid_argument("OpenLoopController: no controller to hand over to");
   for (std::size_t t = 0; t < commands_.size(); ++t) {
@@ -296,15 +297,16 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
                                                std::ostream& out) {
   if (request.out_dir.empty()) throw std::invalid_argument("--out DIR is required");
   if (request.vehicle_path.empty()) throw std::invalid_argument("--vehicle FILE is required");
-  const std::vector<Scenario> scenarios = parse_scenarios(request.scenario);
-  if (scenarios.size() != 1 || scenarios.front() == Scenario::kSuite) {
+  const std::vector<eval::Scenario> scenarios = eval::parse_scenarios(request.scenario);
+  if (scenarios.size() != 1 || scenarios.front() == eval::Scenario::kSuite) {
     throw std::invalid_argument("--scenario: expected one of test1, test2, fault, current, got '" +
                                 request.scenario + "'");
   }
   request.search.validate();
   const sim::VehicleModel model = sim::load_vehicle_file(request.vehicle_path);
-  const EvaluationConfig config = completed(EvaluationConfig{}, model);
-  const EvaluationEpisode episode = scenario_episodes(config, scenarios.front()).front();
+  const eval::EvaluationConfig config = completed(eval::EvaluationConfig{}, model);
+  const eval::EvaluationEpisode episode =
+      eval::scenario_episodes(config, scenarios.front()).front();
   const double dt = config.task.control_step_s;
 
   namespace fs = std::filesystem;
@@ -328,25 +330,25 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
       });
 
   // The evaluation's own figures for the PID and for the found commands with the PID after.
-  std::vector<SummaryRow> rows;
-  std::vector<TrajectoryRow> trajectory;
-  PidController pid(model);
-  rows.push_back(run_evaluation_episode(model, config, pid, episode, &trajectory));
+  std::vector<eval::SummaryRow> rows;
+  std::vector<agent::TrajectoryRow> trajectory;
+  agent::PidController pid(model);
+  rows.push_back(eval::run_evaluation_episode(model, config, pid, episode, &trajectory));
   const int n = model.num_thrusters();
-  write_trajectory_csv(
+  eval::write_trajectory_csv(
       (fs::path(request.out_dir) / "trajectories" / ("pid_" + request.scenario + ".csv")).string(),
       trajectory, n);
   if (result.best_arrival_step > 0) {
-    OpenLoopController found(result.commands, n, std::make_unique<PidController>(model));
-    rows.push_back(run_evaluation_episode(model, config, found, episode, &trajectory));
-    write_trajectory_csv(
+    OpenLoopController found(result.commands, n, std::make_unique<agent::PidController>(model));
+    rows.push_back(eval::run_evaluation_episode(model, config, found, episode, &trajectory));
+    eval::write_trajectory_csv(
         (fs::path(request.out_dir) / "trajectories" / ("open_loop_" + request.scenario + ".csv"))
             .string(),
         trajectory, n);
     write_open_loop_commands_csv((fs::path(request.out_dir) / "commands.csv").string(),
                                  result.commands, dt, config.task.max_thrust_n);
   }
-  write_summary_csv((fs::path(request.out_dir) / "summary.csv").string(), rows);
+  eval::write_summary_csv((fs::path(request.out_dir) / "summary.csv").string(), rows);
   {
     const std::string path = (fs::path(request.out_dir) / "search.csv").string();
     std::ofstream csv(path);
@@ -384,4 +386,4 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
   return result;
 }
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::tools

@@ -25,12 +25,12 @@
 #include <limits>
 #include <vector>
 
-#include "agent/evaluation.hpp"
 #include "common/nn/mlp.hpp"
 #include "common/task/task.hpp"
+#include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tuning {
 
 /// Settings of the fine-tuning (the `finetune:` section of a run configuration).
 struct FinetuneConfig {
@@ -79,7 +79,7 @@ struct FinetuneConfig {
 
 /// One way-point of the objective.
 struct FinetuneEpisode {
-  EpisodeStart start;
+  agent::EpisodeStart start;
   Eigen::Vector3d goal_ned_m = Eigen::Vector3d::Zero();
   /// The PID baseline's objective with only the arrival priced (set_pid_arrivals), s; NaN:
   /// none, and no lag term.
@@ -97,7 +97,7 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
 
 /// The objective of one way-point (see FinetuneConfig::hold_weight), s, for a controller.
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
-                         Controller& controller, const FinetuneEpisode& episode,
+                         agent::Controller& controller, const FinetuneEpisode& episode,
                          const FinetuneConfig& config, double reach_radius_m = 0.5);
 
 /// One iteration's figures.
@@ -127,4 +127,4 @@ FinetuneResult finetune_policy(
     const std::function<void(const FinetuneIteration&, const nn::Mlp& weights)>& progress = {},
     const std::function<bool()>& stop = {});
 
-}  // namespace auvrl::agent
+}  // namespace auvrl::tuning

@@ -1,4 +1,4 @@
-// Evolution-strategies fine-tuning (agent/policy_finetune.hpp): its way-points, the per-way-point
+// Evolution-strategies fine-tuning (tuning/policy_finetune.hpp): its way-points, the per-way-point
 // objective against the evaluation's own figures (its PID lag term and its coarser integrator
 // too), that it lowers the objective of a trained policy, that the thread count does not change
 // the result, and that bad settings are refused.
@@ -13,13 +13,15 @@
 #include <vector>
 
 #include "agent/pid_controller.hpp"
-#include "agent/policy_finetune.hpp"
 #include "agent_test_util.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
+#include "tuning/policy_finetune.hpp"
 
-namespace auvrl::agent {
+namespace auvrl::tuning {
 namespace {
+
+using test_support::nessie;
 
 task::TaskConfig fast_task() {
   task::TaskConfig t;
@@ -67,16 +69,16 @@ TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   e.goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);  // test1
   FinetuneConfig c;
   c.episode_steps = 300;
-  PidController pid(nessie());
+  agent::PidController pid(nessie());
   c.hold_weight = 0.0;
   const double arrival_s = arrival_objective(nessie(), t, pid, e, c);
   // The evaluation's test1 figure for the PID is the first whole step within 0.5 m.
-  EvaluationConfig eval;
+  eval::EvaluationConfig eval;
   eval.task = t;
-  EvaluationEpisode test1;
+  eval::EvaluationEpisode test1;
   test1.goal_ned_m = e.goal_ned_m;
   test1.start = e.start;
-  const SummaryRow row = run_evaluation_episode(nessie(), eval, pid, test1, nullptr);
+  const eval::SummaryRow row = eval::run_evaluation_episode(nessie(), eval, pid, test1, nullptr);
   ASSERT_TRUE(row.reached);
   EXPECT_GT(arrival_s, row.time_to_reach_s - 0.1);
   EXPECT_LE(arrival_s, row.time_to_reach_s);
@@ -94,7 +96,7 @@ TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
   c.hold_weight = 0.0;
   std::vector<FinetuneEpisode> episodes(1);
   episodes[0].goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);  // test1
-  PidController pid(nessie());
+  agent::PidController pid(nessie());
   const double pid_arrival_s = arrival_objective(nessie(), t, pid, episodes[0], c);
   c.pid_lag_weight = 4.0;
   c.pid_lead_s = 0.3;
@@ -115,7 +117,7 @@ TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
 }
 
 /// Never pushes.
-class IdleController final : public Controller {
+class IdleController final : public agent::Controller {
  public:
   void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector&,
            task::ActionVector& action) override {
@@ -147,7 +149,7 @@ TEST(ArrivalObjective, ACoarserIntegratorGivesTheSameObjectiveForATrainedPolicy)
   arrival_only.hold_weight = 0.0;
   arrival_only.flip_margin_weight = 0.0;
   const nn::Mlp policy = committed_policy();
-  PolicyController controller(policy, fast_task().state_dim(), 6);
+  agent::PolicyController controller(policy, fast_task().state_dim(), 6);
   ASSERT_EQ(nessie().substeps, 10);
   double arrival_gap_s = 0.0, fine_sum = 0.0, coarse_sum = 0.0;
   for (const FinetuneEpisode& e : finetune_episodes(fast_task(), c, 5)) {
@@ -214,8 +216,8 @@ TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
   // The returned network is the one that scored best_objective, on the way-points with the
   // PID's arrivals; without them the lag term would be missing.
   std::vector<FinetuneEpisode> episodes = finetune_episodes(fast_task(), c, 1);
-  PolicyController start(detuned_policy(), fast_task().state_dim(), 6);
-  PolicyController best(r.network, fast_task().state_dim(), 6);
+  agent::PolicyController start(detuned_policy(), fast_task().state_dim(), 6);
+  agent::PolicyController best(r.network, fast_task().state_dim(), 6);
   double start_without_pid = 0.0;
   for (const FinetuneEpisode& e : episodes) {
     start_without_pid += arrival_objective(nessie(), fast_task(), start, e, c);
@@ -267,4 +269,4 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
 }
 
 }  // namespace
-}  // namespace auvrl::agent
+}  // namespace auvrl::tuning

@@ -1,0 +1,50 @@
+#include "eval/quick_evaluator.hpp"
+
+#include <random>
+
+#include "agent/pid_controller.hpp"
+
+namespace auvrl::eval {
+
+QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task,
+                               int suite_episodes, int turned)
+    : model_(model), task_(task) {
+  config_.task = task;
+  apply_vehicle(model, config_.task);
+  config_.suite_episodes = suite_episodes + turned;
+  // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
+  // and the suite's seed 1) must not be the ones that choose the policy, or the reported
+  // times would be the best of many draws on the very tests.
+  config_.seed = kValidationSeed;
+  episodes_ = scenario_episodes(config_, Scenario::kSuite);
+  std::mt19937_64 rng(kValidationSeed + 1);
+  for (int i = suite_episodes; i < suite_episodes + turned; ++i) {
+    episodes_[static_cast<std::size_t>(i)].start.euler_rpy_rad[2] =
+        (2.0 * task::unit_draw(rng) - 1.0) * 3.14159265358979323846;
+  }
+  agent::PidController pid(model_);
+  reference_ = run(pid);
+}
+
+ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network) const {
+  agent::PolicyController controller(network, task_.state_dim(), task_.num_thrusters);
+  return score_against_reference(run(controller), reference_);
+}
+
+std::vector<SummaryRow> QuickEvaluator::run(agent::Controller& controller) const {
+  std::vector<SummaryRow> rows;
+  for (const EvaluationEpisode& e : episodes_) {
+    rows.push_back(run_evaluation_episode(model_, config_, controller, e, nullptr));
+  }
+  return rows;
+}
+
+bool finetune_better(const ValidationScore& a, const ValidationScore& b, double max_hold_m) {
+  if (a.reached != b.reached) return a.reached > b.reached;
+  const bool a_holds = a.mean_hold_m <= max_hold_m, b_holds = b.mean_hold_m <= max_hold_m;
+  if (a_holds != b_holds) return a_holds;
+  if (!a_holds && a.mean_hold_m != b.mean_hold_m) return a.mean_hold_m < b.mean_hold_m;
+  return a.mean_time_s < b.mean_time_s;
+}
+
+}  // namespace auvrl::eval

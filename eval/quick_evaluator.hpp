@@ -1,0 +1,52 @@
+// The quick evaluation of candidate policies on validation way-points of their own (never the
+// reported scenarios), scored against the PID baseline on the same way-points: how `auvrl
+// train` keeps its best policy and judges the fine-tuning's weights.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/nn/mlp.hpp"
+#include "common/task/task.hpp"
+#include "eval/evaluation.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace auvrl::eval {
+
+/// Seed of the quick evaluation's way-points (the reported suite uses seed 1).
+constexpr std::uint64_t kValidationSeed = 0x7A11DA7E;
+
+/// The quick evaluation that keeps the best policy: the validation way-points, run once by the
+/// PID baseline at construction and by each candidate policy on demand. With turned > 0, that
+/// many more way-points start facing a random heading (as test2 does; the fine-tuning's
+/// choice, which must not trade the turn for speed).
+/// The quick evaluation that keeps the best policy: the validation way-points, run once by the
+/// PID baseline at construction and by each candidate policy on demand. With turned > 0, that
+/// many more way-points start facing a random heading (as test2 does; the fine-tuning's
+/// choice, which must not trade the turn for speed).
+class QuickEvaluator {
+ public:
+  QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task, int suite_episodes,
+                 int turned = 0);
+
+  /// Runs the policy on the validation way-points and scores it against the PID's runs.
+  ValidationScore evaluate(const nn::Mlp& network) const;
+
+ private:
+  std::vector<SummaryRow> run(agent::Controller& controller) const;
+
+  const sim::VehicleModel& model_;
+  task::TaskConfig task_;
+  EvaluationConfig config_;
+  std::vector<EvaluationEpisode> episodes_;
+  std::vector<SummaryRow> reference_;
+};
+
+/// How the fine-tuning's weights are ranked on the validation way-points: more reached, then
+/// a mean hold error within max_hold_m (or, both outside, the smaller), then the shorter mean
+/// time: what the fine-tuning lowers. (The training's own ranking puts the worst time ratio to
+/// the PID before the mean time; over one way-point of 40 it moves +-0.1-0.2 between
+/// neighbouring iterations and would turn down a second off the mean.)
+bool finetune_better(const ValidationScore& a, const ValidationScore& b, double max_hold_m);
+
+}  // namespace auvrl::eval

@@ -1,0 +1,51 @@
+// The run configuration as the launcher reads it: the `run:` section (its own), and what it
+// needs of the others (vehicle, task, learner.max_episodes, transport, finetune).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "common/task/task.hpp"
+#include "common/transport_options.hpp"
+#include "tuning/policy_finetune.hpp"
+
+namespace auvrl::launcher {
+
+/// The `run:` section of a run configuration.
+struct RunSettings {
+  int actors = 0;                   ///< 0: one per CPU
+  std::uint64_t seed = 1;           ///< actor i uses seed * 1000 + i (+ a restart offset)
+  double max_train_s = 0.0;         ///< wall-clock training budget, s (0: until the learner ends)
+  double best_eval_period_s = 5.0;  ///< quick evaluation of the newest weights, s
+  int best_eval_suite = 40;         ///< validation way-points in that quick evaluation
+  /// The best policy holds within this on average on them, m (ValidationScore::better_than):
+  /// half the evaluation's 0.3 m target, so that a faster policy does not win by drifting.
+  double best_eval_max_hold_m = 0.15;
+  /// CPU the learner is pinned to (-1: not pinned); actors then use the other CPUs.
+  int learner_cpu = -1;
+  /// Each simulator and its actor talk on a bus of their own (port 7668 + i), so nobody else
+  /// receives their ~2 x 20k messages/s; false puts everything on the system's bus.
+  bool private_lockstep_bus = true;
+  int max_restarts = 5;             ///< a role restarted more often than this within...
+  double restart_window_s = 120.0;  ///< ...this many seconds stops the run
+  /// A process silent for this long after its first sign of life is taken as hung, killed
+  /// (SIGKILL) and restarted like a crashed one, s (0: not watched). Signs of life: the
+  /// simulator's SIM_HEARTBEAT, the logger's LOGGER_HEARTBEAT, the learner's LEARNER_STATS
+  /// (each ~1 Hz) and an actor's EPISODE reports.
+  double heartbeat_timeout_s = 60.0;
+};
+
+/// Everything the launcher reads from the run configuration.
+struct RunConfig {
+  RunSettings run;
+  task::TaskConfig task;
+  std::string vehicle_path;
+  std::int64_t learner_max_episodes = 0;
+  transport::TransportConfig transport;  ///< the `transport:` section (LCM by default)
+  tuning::FinetuneConfig finetune;       ///< the `finetune:` section (off by default)
+};
+
+/// Reads and checks a run configuration; throws config::ConfigError naming file, key and line.
+RunConfig read_run_config(const std::string& path);
+
+}  // namespace auvrl::launcher
