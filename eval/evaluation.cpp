@@ -234,16 +234,6 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
   return rows;
 }
 
-bool ValidationScore::better_than(const ValidationScore& other, double max_hold_m) const {
-  if (reached != other.reached) return reached > other.reached;
-  const bool holds = mean_hold_m <= max_hold_m;
-  const bool other_holds = other.mean_hold_m <= max_hold_m;
-  if (holds != other_holds) return holds;
-  if (!holds) return mean_hold_m < other.mean_hold_m;
-  if (max_time_ratio != other.max_time_ratio) return max_time_ratio < other.max_time_ratio;
-  return mean_time_s < other.mean_time_s;
-}
-
 ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
                                         const std::vector<SummaryRow>& reference) {
   if (rows.size() != reference.size()) {

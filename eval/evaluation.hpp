@@ -118,7 +118,8 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
                                        const std::string& out_dir);
 
 /// How a candidate policy did on validation way-points, against a reference controller (the
-/// PID baseline) on the same way-points: what `auvrl train` keeps its best policy by.
+/// PID baseline) on the same way-points: what `auvrl train` keeps its best policy by
+/// (eval/ranking.hpp ranks two of them).
 struct ValidationScore {
   /// What a figure holds when nothing was reached (ranks below any real one).
   static constexpr double kNone = 1e9;
@@ -130,12 +131,6 @@ struct ValidationScore {
   /// Worst ratio of the candidate's time to reach to the reference's, over the way-points both
   /// reached (kNone: none): below 1, it reached every way-point sooner than the reference.
   double max_time_ratio = kNone;
-
-  /// Ranks: more way-points reached; then a mean hold error within max_hold_m (or, both
-  /// outside, the smaller); then the smaller worst ratio; then the shorter mean time. The worst
-  /// ratio rather than the mean time, because the evaluation compares the policy with the PID
-  /// scenario by scenario (a policy much faster on most way-points can still lose on one).
-  bool better_than(const ValidationScore& other, double max_hold_m) const;
 };
 
 /// Scores `rows` (the candidate's) against `reference` (the same episodes, in the same order,

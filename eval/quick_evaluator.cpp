@@ -39,12 +39,4 @@ std::vector<SummaryRow> QuickEvaluator::run(agent::Controller& controller) const
   return rows;
 }
 
-bool finetune_better(const ValidationScore& a, const ValidationScore& b, double max_hold_m) {
-  if (a.reached != b.reached) return a.reached > b.reached;
-  const bool a_holds = a.mean_hold_m <= max_hold_m, b_holds = b.mean_hold_m <= max_hold_m;
-  if (a_holds != b_holds) return a_holds;
-  if (!a_holds && a.mean_hold_m != b.mean_hold_m) return a.mean_hold_m < b.mean_hold_m;
-  return a.mean_time_s < b.mean_time_s;
-}
-
 }  // namespace auvrl::eval

@@ -42,11 +42,4 @@ class QuickEvaluator {
   std::vector<SummaryRow> reference_;
 };
 
-/// How the fine-tuning's weights are ranked on the validation way-points: more reached, then
-/// a mean hold error within max_hold_m (or, both outside, the smaller), then the shorter mean
-/// time: what the fine-tuning lowers. (The training's own ranking puts the worst time ratio to
-/// the PID before the mean time; over one way-point of 40 it moves +-0.1-0.2 between
-/// neighbouring iterations and would turn down a second off the mean.)
-bool finetune_better(const ValidationScore& a, const ValidationScore& b, double max_hold_m);
-
 }  // namespace auvrl::eval

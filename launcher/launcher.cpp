@@ -36,6 +36,7 @@
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/quick_evaluator.hpp"
+#include "eval/ranking.hpp"
 #include "launcher/run_config.hpp"
 #include "sim/vehicle_model.hpp"
 #include "tuning/policy_finetune.hpp"
@@ -190,7 +191,7 @@ std::string finetune_stage(const sim::VehicleModel& model, const task::TaskConfi
           const eval::ValidationScore score = quick.evaluate(weights);
           csv << ',' << score.reached << ',' << score.mean_time_s << ',' << score.mean_hold_m << ','
               << score.max_time_ratio;
-          if (eval::finetune_better(score, best, max_hold_m)) {
+          if (eval::ranks_above(score, best, {max_hold_m, false})) {
             best = score;
             best_net = weights;
             best_iteration = it.iteration;
@@ -584,7 +585,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
           nn::Mlp net = nn::network_from_bytes(
               reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
           const eval::ValidationScore score = quick.evaluate(net);
-          const bool keep = best_version < 0 || score.better_than(best, max_hold_m);
+          const bool keep = best_version < 0 || eval::ranks_above(score, best, {max_hold_m, true});
           if (keep) {
             best = score;
             best_version = w->version;
@@ -699,7 +700,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     // The last policy may be worse than the best seen: compare them on the quick evaluation.
     try {
       const nn::Mlp last = nn::network_from_bytes(nn::read_file(policy_path), 1);
-      if (best.better_than(quick.evaluate(last), max_hold_m)) {
+      if (eval::ranks_above(best, quick.evaluate(last), {max_hold_m, true})) {
         policy_path = (run_dir / "policy_best.nn").string();
       }
     } catch (const std::exception&) {

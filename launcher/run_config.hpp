@@ -18,7 +18,7 @@ struct RunSettings {
   double max_train_s = 0.0;         ///< wall-clock training budget, s (0: until the learner ends)
   double best_eval_period_s = 5.0;  ///< quick evaluation of the newest weights, s
   int best_eval_suite = 40;         ///< validation way-points in that quick evaluation
-  /// The best policy holds within this on average on them, m (ValidationScore::better_than):
+  /// The best policy holds within this on average on them, m (eval::ranks_above):
   /// half the evaluation's 0.3 m target, so that a faster policy does not win by drifting.
   double best_eval_max_hold_m = 0.15;
   /// CPU the learner is pinned to (-1: not pinned); actors then use the other CPUs.

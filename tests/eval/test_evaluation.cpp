@@ -17,6 +17,7 @@
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "eval/evaluation.hpp"
+#include "eval/ranking.hpp"
 
 namespace auvrl::eval {
 namespace {
@@ -256,8 +257,8 @@ TEST(ValidationScore, RowsThatAreNotTheReferencesEpisodesAreAnError) {
   }
 }
 
-TEST(ValidationScore, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
-  const double max_hold_m = 0.15;
+TEST(Ranking, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
+  const Ranking training{0.15, true};
   ValidationScore a, b;
   a.episodes = b.episodes = 40;
   a.reached = 40;
@@ -265,25 +266,41 @@ TEST(ValidationScore, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
   a.max_time_ratio = 2.0;
   b.max_time_ratio = 0.8;
   a.mean_hold_m = b.mean_hold_m = 0.05;
-  EXPECT_TRUE(a.better_than(b, max_hold_m));  // reaching more way-points comes first
-  EXPECT_FALSE(b.better_than(a, max_hold_m));
+  EXPECT_TRUE(ranks_above(a, b, training));  // reaching more way-points comes first
+  EXPECT_FALSE(ranks_above(b, a, training));
 
   b.reached = 40;
-  EXPECT_TRUE(b.better_than(a, max_hold_m));  // then the worst ratio to the PID
-  EXPECT_FALSE(a.better_than(b, max_hold_m));
+  EXPECT_TRUE(ranks_above(b, a, training));  // then the worst ratio to the PID
+  EXPECT_FALSE(ranks_above(a, b, training));
 
   b.mean_hold_m = 0.2;  // faster, but drifting: holding within the limit comes before speed
-  EXPECT_TRUE(a.better_than(b, max_hold_m));
+  EXPECT_TRUE(ranks_above(a, b, training));
   a.mean_hold_m = 0.3;  // both outside: the closer wins
-  EXPECT_TRUE(b.better_than(a, max_hold_m));
+  EXPECT_TRUE(ranks_above(b, a, training));
 
   a.mean_hold_m = b.mean_hold_m = 0.05;
   a.max_time_ratio = b.max_time_ratio = 0.9;
   a.mean_time_s = 9.0;
   b.mean_time_s = 9.5;
-  EXPECT_TRUE(a.better_than(b, max_hold_m));  // the same worst ratio: the shorter mean time
-  EXPECT_FALSE(b.better_than(a, max_hold_m));
-  EXPECT_FALSE(a.better_than(a, max_hold_m));
+  EXPECT_TRUE(ranks_above(a, b, training));  // the same worst ratio: the shorter mean time
+  EXPECT_FALSE(ranks_above(b, a, training));
+  EXPECT_FALSE(ranks_above(a, a, training));
+}
+
+TEST(Ranking, TheFineTuningsRankingSkipsTheWorstRatio) {
+  const Ranking finetuning{0.15, false};
+  ValidationScore a, b;
+  a.episodes = b.episodes = a.reached = b.reached = 40;
+  a.mean_hold_m = b.mean_hold_m = 0.05;
+  a.max_time_ratio = 1.2;  // slower than the PID on one way-point...
+  b.max_time_ratio = 0.9;
+  a.mean_time_s = 8.0;  // ...but a second sooner on the mean: what the fine-tuning lowers
+  b.mean_time_s = 9.0;
+  EXPECT_TRUE(ranks_above(a, b, finetuning));
+  EXPECT_FALSE(ranks_above(b, a, finetuning));
+  EXPECT_TRUE(ranks_above(b, a, Ranking{0.15, true}));
+  a.mean_hold_m = 0.3;  // holding still comes before time
+  EXPECT_TRUE(ranks_above(b, a, finetuning));
 }
 
 TEST(Evaluation, InfersTheLayoutFromThePolicyInputs) {
