@@ -31,6 +31,7 @@ class BestPolicyKeeper {
   /// them at the end of training. Throws if it cannot be read.
   bool best_ranks_above(const std::string& path) const;
 
+  /// Whether a best policy exists (evaluated this run or restored).
   bool has_best() const { return best_version_ >= 0; }
   /// The best policy's score (meaningful when has_best()).
   const eval::ValidationScore& best() const { return best_; }
@@ -38,6 +39,7 @@ class BestPolicyKeeper {
   std::int64_t best_version() const { return best_version_; }
   /// The best's path.
   std::string best_path() const;
+  /// The ranking's hold limit, m.
   double max_hold_m() const { return max_hold_m_; }
 
  private:

@@ -22,6 +22,7 @@ class EpisodeSink {
   explicit EpisodeSink(const std::string& path);
   /// One episode, wall_s into the run's training time.
   void add(double wall_s, const auvrl_lcm::episode_report_t& e);
+  /// The file's writer (flush, path).
   csv::Writer& writer() { return writer_; }
 
  private:
@@ -34,6 +35,7 @@ class LearnerSink {
   explicit LearnerSink(const std::string& path);
   /// The learner's figures, wall_s into the run's training time.
   void add(double wall_s, const auvrl_lcm::learner_stats_t& s);
+  /// The file's writer (flush, path).
   csv::Writer& writer() { return writer_; }
 
  private:
@@ -56,7 +58,9 @@ struct ProgressRow {
 class ProgressSink {
  public:
   explicit ProgressSink(const std::string& path);
+  /// One row.
   void add(const ProgressRow& row);
+  /// The file's writer (flush, path).
   csv::Writer& writer() { return writer_; }
 
  private:
@@ -70,6 +74,7 @@ class QuickEvalSink {
   explicit QuickEvalSink(const std::string& path);
   /// One evaluation of policy `version` at wall_s; kept: it became the best so far.
   void add(double wall_s, std::int64_t version, const eval::ValidationScore& score, bool kept);
+  /// The file's writer (flush, path).
   csv::Writer& writer() { return writer_; }
 
  private:
@@ -81,8 +86,10 @@ class QuickEvalSink {
 class FinetuneSink {
  public:
   explicit FinetuneSink(const std::string& path);
+  /// One iteration; validation: its validation score, or nullptr when not validated.
   void add(int iteration, double objective_s, double elapsed_s,
            const eval::ValidationScore* validation);
+  /// The file's writer (flush, path).
   csv::Writer& writer() { return writer_; }
 
  private:
