@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "launcher/run_directory.hpp"
+
 namespace auvrl::launcher {
 
 /// What `auvrl train` was asked.
@@ -32,13 +34,8 @@ struct TrainOptions {
   std::vector<std::string> transport_args;
 };
 
-/// Creates the run directory of a new run (config copy, folders) or checks an existing one for
-/// --resume; returns the path of the run's configuration. Throws std::runtime_error naming
-/// what is wrong.
-std::string prepare_run_directory(TrainOptions& options);
-
-/// Runs training (already inside the network namespace, or with --network host), then the
-/// evaluation. Returns the process exit code.
+/// Runs the pipeline train -> select -> fine-tune -> evaluate -> report (already inside the
+/// network namespace, or with --network host). Returns the process exit code.
 int run_training(const TrainOptions& options, std::ostream& out);
 
 }  // namespace auvrl::launcher

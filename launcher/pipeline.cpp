@@ -1,0 +1,155 @@
+#include "launcher/pipeline.hpp"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "agent/controller.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+#include "common/process.hpp"
+#include "common/signals.hpp"
+#include "eval/ranking.hpp"
+#include "launcher/format.hpp"
+#include "tuning/policy_finetune.hpp"
+
+namespace auvrl::launcher {
+
+namespace fs = std::filesystem;
+
+std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best) {
+  std::string policy_path = (fs::path(run_dir) / "policy.nn").string();
+  if (fs::exists(best.best_path())) {
+    // The last policy may be worse than the best seen: compare them on the quick evaluation.
+    try {
+      if (best.best_ranks_above(policy_path)) policy_path = best.best_path();
+    } catch (const std::exception&) {
+      policy_path = best.best_path();
+    }
+  }
+  if (!fs::exists(policy_path)) return std::nullopt;
+  return policy_path;
+}
+
+namespace {
+
+std::string describe(const eval::ValidationScore& v) {
+  return fmt::format(
+      "{}/{} reached, mean {:.2f} s, hold {:.2f} m, worst time ratio to the PID {:.2f}", v.reached,
+      v.episodes, v.mean_time_s, v.mean_hold_m, v.max_time_ratio);
+}
+
+/// The best validated weights of a fine-tuning so far.
+struct FinetuneBest {
+  eval::ValidationScore score;
+  std::optional<nn::Mlp> net;
+  int iteration = 0;
+};
+
+}  // namespace
+
+std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
+                           std::ostream& out) {
+  constexpr int validate_every = 10;
+  const nn::Mlp start = nn::network_from_bytes(nn::read_file(start_path), 1);
+  out << fmt::format(
+      "auvrl train: fine-tuning {} (evolution strategies, {} iterations of {} policies on {} "
+      "way-points)\n",
+      start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes);
+  const eval::ValidationScore before = in.validation.evaluate(start);
+  FinetuneBest best{before, std::nullopt, 0};
+  FinetuneSink csv((fs::path(in.run_dir) / "finetune.csv").string());
+  const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
+    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations) {
+      csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
+      return;
+    }
+    const eval::ValidationScore score = in.validation.evaluate(weights);
+    csv.add(it.iteration, it.objective, it.elapsed_s, &score);
+    if (eval::ranks_above(score, best.score, {in.max_hold_m, false}))
+      best = {score, weights, it.iteration};
+    out << fmt::format(
+        "auvrl train: fine-tuning {}/{}  objective {:.3f} s  validation {}/{} mean {:.2f} s  "
+        "elapsed {}\n",
+        it.iteration, in.config.iterations, it.objective, score.reached, score.episodes,
+        score.mean_time_s, format_duration(it.elapsed_s));
+  };
+  const tuning::FinetuneResult result =
+      tuning::finetune_policy(in.model, in.task, start, in.config, in.seed, progress,
+                              [] { return signals::stop_requested(); });
+  try {
+    csv.writer().flush();
+  } catch (const std::exception&) {
+    out << "auvrl train: could not write " << csv.writer().path() << "\n";
+  }
+  out << fmt::format("auvrl train: fine-tuned: objective {:.3f} -> {:.3f} s\n",
+                     result.start_objective, result.best_objective)
+      << "  validation before: " << describe(before) << "\n";
+  if (!best.net) {
+    out << "  not kept: no fine-tuned weights scored better on the validation way-points\n";
+    return start_path;
+  }
+  const std::string tuned_path = (fs::path(in.run_dir) / "policy_finetuned.nn").string();
+  nn::save_network_file(tuned_path, *best.net);
+  out << "  validation after:  " << describe(best.score) << " (iteration " << best.iteration
+      << ")\n"
+      << "  kept: " << tuned_path << "\n";
+  return tuned_path;
+}
+
+std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
+                                   std::ostream& out) {
+  if (ctx.rc.finetune.iterations <= 0) return policy_path;
+  // The quick evaluation's way-points, and half as many again facing a random heading.
+  const eval::QuickEvaluator validation(ctx.model, ctx.rc.task, ctx.rc.run.best_eval_suite,
+                                        ctx.rc.run.best_eval_suite / 2);
+  try {
+    return finetune_stage({ctx.model, ctx.rc.task, ctx.rc.finetune, ctx.rc.run.seed, validation,
+                           ctx.rc.run.best_eval_max_hold_m, ctx.run_dir},
+                          policy_path, out);
+  } catch (const std::exception& e) {
+    // The trained policy stays: a failed fine-tuning (a full disk, say) loses nothing.
+    out << "auvrl train: fine-tuning failed: " << e.what() << "; keeping " << policy_path << "\n";
+    return policy_path;
+  }
+}
+
+EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy_path,
+                                std::ostream& out) {
+  out << "auvrl train: evaluating " << policy_path << " and the PID baseline\n";
+  const fs::path eval_dir = fs::path(ctx.run_dir) / "eval";
+  eval::EvaluationConfig config;
+  config.task = ctx.rc.task;
+  const std::vector<eval::Scenario> all = eval::parse_scenarios("all");
+  const nn::Mlp policy_net = nn::network_from_bytes(nn::read_file(policy_path), 1);
+  agent::PolicyController policy(policy_net, ctx.rc.task.state_dim(), ctx.rc.task.num_thrusters);
+  EvaluationResult result;
+  result.policy_rows =
+      eval::run_evaluation(ctx.model, config, policy, all, (eval_dir / "policy").string());
+  eval::EvalRequest pid_request;
+  pid_request.controller = "pid";
+  eval::EvaluationConfig pid_config = config;
+  auto pid = eval::make_eval_controller(pid_request, ctx.model, pid_config);
+  result.pid_rows =
+      eval::run_evaluation(ctx.model, pid_config, *pid, all, (eval_dir / "pid").string());
+  std::ofstream(eval_dir / "selected_policy.txt") << policy_path << "\n";
+  return result;
+}
+
+void report_stage(const RunContext& ctx, const std::string& policy_path,
+                  const EvaluationResult& result, std::ostream& out) {
+  const std::string plot = ctx.options.source_dir + "/scripts/plot_run.py";
+  if (fs::exists(plot) && fs::exists("/usr/bin/python3")) {
+    process::ChildProcess plotter({"/usr/bin/python3", plot, ctx.run_dir},
+                                  (fs::path(ctx.run_dir) / "processes" / "plots.log").string());
+    const int status = plotter.wait_for_exit(std::chrono::minutes(5));
+    if (status != 0) out << "auvrl train: plotting failed (see " << plotter.log_path() << ")\n";
+  }
+  out << "\nlearned policy (" << policy_path << "):\n"
+      << eval::format_summary_table(result.policy_rows) << "\nPID baseline:\n"
+      << eval::format_summary_table(result.pid_rows)
+      << "\nreport: " << (fs::path(ctx.run_dir) / "report.md").string() << "\n";
+}
+
+}  // namespace auvrl::launcher

@@ -1,0 +1,62 @@
+// The stages after training: select (the last policy or the best seen) -> fine-tune ->
+// evaluate (the policy and the PID baseline) -> report (plots, summary tables).
+#pragma once
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "eval/evaluation.hpp"
+#include "eval/quick_evaluator.hpp"
+#include "launcher/best_policy.hpp"
+#include "launcher/telemetry.hpp"
+#include "launcher/training.hpp"
+
+namespace auvrl::launcher {
+
+/// The trained policy to go on with: policy.nn, or policy_best.nn when the best seen ranks
+/// above the last one (or the last one cannot be read). Nothing when neither file exists.
+std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best);
+
+/// What the fine-tuning stage needs besides the policy.
+struct FinetuneStageInput {
+  const sim::VehicleModel& model;
+  const task::TaskConfig& task;
+  const tuning::FinetuneConfig& config;
+  std::uint64_t seed = 1;
+  const eval::QuickEvaluator& validation;  ///< scores candidate weights
+  double max_hold_m = 0.15;                ///< the ranking's hold limit, m
+  std::string run_dir;
+};
+
+/// Fine-tunes the policy at start_path (progress to finetune.csv) and returns the path of the
+/// policy to keep. The weights are scored on validation way-points every validate_every
+/// iterations and at the end; the best of them, if better than the start there, is written to
+/// policy_finetuned.nn and kept. (The fine-tuning's own way-points are few: a step that lowers
+/// their objective can lose a way-point elsewhere.) Ctrl-C ends it after the iteration under
+/// way.
+std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
+                           std::ostream& out);
+
+/// Runs the fine-tuning stage when configured; on a failure keeps policy_path. Returns the path
+/// of the policy to evaluate.
+std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
+                                   std::ostream& out);
+
+/// The evaluation of a policy and of the PID baseline on every scenario.
+struct EvaluationResult {
+  std::vector<eval::SummaryRow> policy_rows;
+  std::vector<eval::SummaryRow> pid_rows;
+};
+
+/// Evaluates the policy at policy_path and the PID baseline into <run_dir>/eval/.
+EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy_path,
+                                std::ostream& out);
+
+/// Draws the plots (scripts/plot_run.py, which also writes report.md) and prints the summary
+/// tables.
+void report_stage(const RunContext& ctx, const std::string& policy_path,
+                  const EvaluationResult& result, std::ostream& out);
+
+}  // namespace auvrl::launcher

@@ -1,0 +1,99 @@
+#include "launcher/run_directory.hpp"
+
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "launcher/launcher.hpp"
+#include "launcher/run_config.hpp"
+
+namespace auvrl::launcher {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string timestamp() {
+  const std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return text;
+}
+
+/// Copies the configuration into the run directory with its vehicle path made absolute, so
+/// that the copy resolves the vehicle the same way.
+void copy_config(const std::string& config_path, const fs::path& run_dir) {
+  std::ifstream in(config_path);
+  std::ofstream out(run_dir / "config.yaml");
+  std::string line;
+  const RunConfig parsed = read_run_config(config_path);
+  out << "# Copied from " << fs::absolute(config_path).string() << " by auvrl train.\n";
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) == 0) {
+      out << "vehicle: " << fs::absolute(parsed.vehicle_path).lexically_normal().string() << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+  if (!out) throw std::runtime_error("cannot write " + run_dir.string() + "/config.yaml");
+}
+
+/// README.txt: what each file of the run directory holds.
+void write_readme(const std::string& run_dir) {
+  std::ofstream howto(fs::path(run_dir) / "README.txt");
+  howto << "auvrl run directory\n"
+        << "  config.yaml       the configuration of this run\n"
+        << "  progress.csv      training progress (also on the terminal)\n"
+        << "  episodes.csv      one row per episode; learner.csv: the learner's figures\n"
+        << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
+        << "  checkpoints/      learner checkpoints (auvrl train --resume " << run_dir << ")\n"
+        << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
+        << "  policy_finetuned.nn, finetune.csv   the fine-tuned policy and its progress\n"
+        << "  quick_eval.csv    every quick evaluation (reached, mean time, hold error, worst\n"
+           "                    time ratio to the PID's on the same way-points, kept)\n"
+        << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"
+        << "  processes/        each process's output\n"
+        << "Watch the running system with lcm-spy: scripts/spy.sh " << run_dir << "\n";
+}
+
+}  // namespace
+
+std::string prepare_run_directory(TrainOptions& o) {
+  const std::string config_copy = (fs::path(o.run_dir) / "config.yaml").string();
+  if (o.resume) {
+    if (!fs::is_regular_file(config_copy)) {
+      throw std::runtime_error("--resume " + o.run_dir + ": no config.yaml there (not a run)");
+    }
+    return config_copy;
+  }
+  if (o.config_path.empty() || !fs::is_regular_file(o.config_path)) {
+    throw std::runtime_error("configuration '" + o.config_path + "' not found");
+  }
+  read_run_config(o.config_path);  // a broken configuration fails here, before anything starts
+  if (o.run_dir.empty()) {
+    o.run_dir = (fs::path(o.source_dir) / "runs" /
+                 (fs::path(o.config_path).stem().string() + "-" + timestamp()))
+                    .string();
+  }
+  if (fs::exists(fs::path(o.run_dir) / "config.yaml")) {
+    throw std::runtime_error(o.run_dir + " already holds a run (use --resume to continue it)");
+  }
+  for (const char* sub : {"logs", "checkpoints", "eval", "plots", "processes"}) {
+    fs::create_directories(fs::path(o.run_dir) / sub);
+  }
+  copy_config(o.config_path, o.run_dir);
+  write_readme(o.run_dir);
+  return (fs::path(o.run_dir) / "config.yaml").string();
+}
+
+bool has_checkpoint_file(const std::string& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("checkpoint-", 0) == 0 && entry.path().extension() == ".ckpt") return true;
+  }
+  return false;
+}
+
+}  // namespace auvrl::launcher

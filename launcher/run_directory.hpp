@@ -1,0 +1,20 @@
+// The run directory of `auvrl train`: config.yaml (a copy of the configuration), README.txt,
+// logs/, checkpoints/, eval/, plots/, processes/ and the CSV files of the run.
+#pragma once
+
+#include <string>
+
+namespace auvrl::launcher {
+
+struct TrainOptions;
+
+/// Creates the run directory of a new run (config copy, folders) or checks an existing one for
+/// --resume; returns the path of the run's configuration. Throws std::runtime_error naming
+/// what is wrong.
+std::string prepare_run_directory(TrainOptions& options);
+
+/// Whether dir holds a finished learner checkpoint (checkpoint-<updates>.ckpt). A learner
+/// killed while writing leaves only its temporary file, which --resume cannot use.
+bool has_checkpoint_file(const std::string& dir);
+
+}  // namespace auvrl::launcher

@@ -1,0 +1,397 @@
+#include "launcher/training.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <auvrl_lcm/episode_report_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
+#include <auvrl_lcm/logger_heartbeat_t.hpp>
+#include <auvrl_lcm/policy_weights_t.hpp>
+#include <auvrl_lcm/sim_heartbeat_t.hpp>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include "common/channels.hpp"
+#include "common/nn/serialize.hpp"
+#include "common/signals.hpp"
+#include "common/transport.hpp"
+#include "common/transport_options.hpp"
+#include "launcher/format.hpp"
+#include "launcher/run_directory.hpp"
+#include "launcher/telemetry.hpp"
+
+namespace auvrl::launcher {
+
+namespace fs = std::filesystem;
+
+RunContext load_run_context(const TrainOptions& options) {
+  RunContext ctx{
+      options, options.run_dir, (fs::path(options.run_dir) / "config.yaml").string(), {}, {}, 1, 1};
+  RunConfig& rc = ctx.rc;
+  rc = read_run_config(ctx.config_path);
+  if (options.actors >= 0) rc.run.actors = options.actors;
+  if (options.max_train_s >= 0) rc.run.max_train_s = options.max_train_s;
+  if (options.seed >= 0) rc.run.seed = static_cast<std::uint64_t>(options.seed);
+  if (options.finetune_iterations >= 0) rc.finetune.iterations = options.finetune_iterations;
+  ctx.cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  ctx.actors = rc.run.actors > 0 ? rc.run.actors : ctx.cpus;
+  ctx.model = sim::load_vehicle_file(rc.vehicle_path);
+  rc.task.num_thrusters = ctx.model.num_thrusters();
+  rc.task.max_thrust_n = ctx.model.thruster_dynamics.max_thrust_n;
+  transport::apply_transport_arguments(options.transport_args, rc.transport);
+  const bool dds = rc.transport.kind == transport::TransportKind::kDds;
+  if (dds && rc.run.private_lockstep_bus && rc.transport.dds.domain_id + ctx.actors > 232) {
+    throw std::runtime_error(
+        fmt::format("DDS domain {} + one lockstep domain per actor ({}) passes 232: choose a "
+                    "lower transport.dds_domain",
+                    rc.transport.dds.domain_id, ctx.actors));
+  }
+  return ctx;
+}
+
+namespace {
+
+std::vector<std::string> concat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+/// A role whose command line is the same at every start.
+RoleSpec fixed_role(const RunContext& ctx, std::string name, RoleKind kind,
+                    std::vector<std::string> argv) {
+  const std::string log_path = (fs::path(ctx.run_dir) / "processes" / (name + ".log")).string();
+  return {std::move(name), kind, [argv = std::move(argv)](std::size_t) { return argv; }, log_path,
+          -1};
+}
+
+/// The private lockstep bus of pair i: an LCM port, or a DDS domain, of its own.
+std::vector<std::string> lockstep_args(const RunContext& ctx, int i) {
+  if (!ctx.rc.run.private_lockstep_bus) return {};
+  if (ctx.rc.transport.kind == transport::TransportKind::kDds) {
+    return {"--lockstep-dds-domain", std::to_string(ctx.rc.transport.dds.domain_id + 1 + i)};
+  }
+  return {"--lockstep-lcm-url",
+          fmt::format("udpm://239.255.76.67:{}?ttl=0&recv_buf_size=1048576", 7668 + i)};
+}
+
+/// The learner's command line (pinned to run.learner_cpu when set).
+std::vector<std::string> learner_argv(const RunContext& ctx, const std::string& bin) {
+  std::vector<std::string> argv = {bin + "auv_learner", "--config", ctx.config_path,
+                                   "--checkpoint-dir",
+                                   (fs::path(ctx.run_dir) / "checkpoints").string(), "--policy-out",
+                                   (fs::path(ctx.run_dir) / "policy.nn").string(), "--max-actors",
+                                   std::to_string(std::max(ctx.actors, 1)),
+                                   // The run's seed also seeds the networks, the minibatches
+                                   // and TD3's noise.
+                                   "--seed", std::to_string(ctx.rc.run.seed)};
+  if (ctx.rc.run.learner_cpu >= 0 && ctx.rc.run.learner_cpu < ctx.cpus) {
+    argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(ctx.rc.run.learner_cpu)});
+  }
+  return argv;
+}
+
+/// Actor i's role: a restarted actor explores anew (another seed) rather than repeating its
+/// first life.
+RoleSpec actor_role(const RunContext& ctx, int i, int cpu, const std::string& bin,
+                    const std::vector<std::string>& transport_args) {
+  const std::uint64_t seed = ctx.rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
+  const std::vector<std::string> bus = concat(lockstep_args(ctx, i), transport_args);
+  const std::string config_path = ctx.config_path;
+  RoleSpec role = fixed_role(ctx, "actor" + std::to_string(i), RoleKind::kActor, {});
+  role.actor_id = i;
+  role.argv = [=](std::size_t restarts) {
+    return concat(
+        {bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
+         "--vehicle-id", std::to_string(i), "--seed", std::to_string(seed + 7919 * restarts),
+         "--pin-cpu", std::to_string(cpu), "--report-every", "100"},
+        bus);
+  };
+  return role;
+}
+
+}  // namespace
+
+std::vector<RoleSpec> make_roles(const RunContext& ctx,
+                                 const std::vector<std::string>& transport_args) {
+  const std::string bin = ctx.options.bin_dir + "/";
+  const fs::path run_dir = ctx.run_dir;
+  std::vector<RoleSpec> roles;
+  roles.push_back(fixed_role(
+      ctx, "logger", RoleKind::kLogger,
+      concat({bin + "auv_logger", "--dir", (run_dir / "logs").string()}, transport_args)));
+  // Actors (each beside its simulator) on the CPUs the learner does not have, if any.
+  std::vector<int> actor_cpus;
+  for (int c = 0; c < ctx.cpus; ++c) {
+    if (c != ctx.rc.run.learner_cpu || ctx.cpus == 1) actor_cpus.push_back(c);
+  }
+  const auto cpu_of = [&](int i) {
+    return actor_cpus[static_cast<std::size_t>(i) % actor_cpus.size()];
+  };
+  for (int i = 0; i < ctx.actors; ++i) {
+    std::vector<std::string> argv = {"/usr/bin/taskset", "-c",        std::to_string(cpu_of(i)),
+                                     bin + "auv_sim",    "--vehicle", ctx.rc.vehicle_path,
+                                     "--vehicles",       "1",         "--first-vehicle-id",
+                                     std::to_string(i)};
+    argv = concat(concat(argv, lockstep_args(ctx, i)), transport_args);
+    roles.push_back(fixed_role(ctx, "sim" + std::to_string(i), RoleKind::kSim, argv));
+  }
+  RoleSpec learner = fixed_role(ctx, "learner", RoleKind::kLearner, {});
+  const std::vector<std::string> base = concat(learner_argv(ctx, bin), transport_args);
+  const std::string checkpoints = (run_dir / "checkpoints").string();
+  learner.argv = [base, checkpoints](std::size_t) {
+    return has_checkpoint_file(checkpoints) ? concat(base, {"--resume"}) : base;
+  };
+  roles.push_back(std::move(learner));
+  for (int i = 0; i < ctx.actors; ++i) {
+    roles.push_back(actor_role(ctx, i, cpu_of(i), bin, transport_args));
+  }
+  return roles;
+}
+
+namespace {
+
+/// The figures of the status line, gathered from the traffic.
+struct TrainingFigures {
+  std::deque<bool> recent_success;  ///< the last 100 episodes' outcomes
+  std::int64_t episodes_seen = 0;   ///< episode reports received by this invocation
+  double beta_m = 0;                ///< the newest goal radius, m
+  std::optional<auvrl_lcm::learner_stats_t> last_stats;
+  std::int64_t learner_episodes = 0;
+  std::map<int, double> sim_steps_per_s;  ///< by simulator process id
+
+  double success_rate() const {
+    const auto successes = std::count(recent_success.begin(), recent_success.end(), true);
+    return recent_success.empty() ? 0.0 : static_cast<double>(successes) / recent_success.size();
+  }
+  double steps_per_s() const {
+    double sum = 0;
+    for (const auto& entry : sim_steps_per_s) sum += entry.second;
+    return sum;
+  }
+};
+
+/// One training stage: the transport, the supervised processes and what they report.
+class TrainingSession {
+ public:
+  TrainingSession(const RunContext& ctx, std::ostream& out)
+      : ctx_(ctx),
+        out_(out),
+        tty_(isatty(STDOUT_FILENO) != 0),
+        trained_before_s_(trained_before_s(ctx.run_dir)),
+        telemetry_(ctx.run_dir),
+        supervisor_(
+            {ctx.rc.run.max_restarts, ctx.rc.run.restart_window_s, ctx.rc.run.heartbeat_timeout_s},
+            clock_, starter_, out, tty_) {}
+
+  TrainingResult run();
+
+ private:
+  double wall_s() const { return trained_before_s_ + clock_.now_s() - start_s_; }
+  void subscribe();
+  void start_processes();
+  SupervisionOutcome supervise_pass();
+  void evaluate_newest_weights();
+  std::optional<std::string> show_progress();
+  std::string status_line(double eta_s) const;
+  void stop_processes();
+  void print_summary(int exit_code);
+
+  const RunContext& ctx_;
+  std::ostream& out_;
+  const bool tty_;
+  const double trained_before_s_;
+  SteadyClock clock_;
+  ChildProcessStarter starter_;
+  TrainingTelemetry telemetry_;
+  Supervisor supervisor_;
+  TrainingFigures figures_;
+  std::unique_ptr<BestPolicyKeeper> best_;
+  double start_s_ = clock_.now_s();
+  double next_progress_s_ = 0;
+  double next_best_eval_s_ = 0;
+  double last_print_s_ = -1e9;
+  // Last, so that it goes first: its handlers use the members above.
+  std::unique_ptr<transport::Transport> transport_;
+  std::unique_ptr<transport::Latest<auvrl_lcm::policy_weights_t>> weights_;
+};
+
+void TrainingSession::subscribe() {
+  transport_ = transport::make_transport(ctx_.rc.transport);
+  transport::subscribe<auvrl_lcm::episode_report_t>(
+      *transport_, channels::kEpisode,
+      [this](const std::string&, const auvrl_lcm::episode_report_t& e) {
+        supervisor_.heard_from_actor(e.actor_id);
+        ++figures_.episodes_seen;
+        figures_.beta_m = e.beta_m;
+        figures_.recent_success.push_back(e.success);
+        if (figures_.recent_success.size() > 100) figures_.recent_success.pop_front();
+        telemetry_.episodes.add(wall_s(), e);
+      });
+  transport::subscribe<auvrl_lcm::learner_stats_t>(
+      *transport_, channels::kLearnerStats,
+      [this](const std::string&, const auvrl_lcm::learner_stats_t& s) {
+        supervisor_.heard_from_pid(s.pid);
+        figures_.last_stats = s;
+        figures_.learner_episodes = s.episodes;
+        telemetry_.learner.add(wall_s(), s);
+      });
+  transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
+      *transport_, channels::kSimHeartbeat,
+      [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
+        supervisor_.heard_from_pid(h.pid);
+        figures_.sim_steps_per_s[h.pid] = h.steps_per_s;
+      });
+  transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
+      *transport_, channels::kLoggerHeartbeat,
+      [this](const std::string&, const auvrl_lcm::logger_heartbeat_t& h) {
+        supervisor_.heard_from_pid(h.pid);
+      });
+  weights_ = std::make_unique<transport::Latest<auvrl_lcm::policy_weights_t>>(
+      *transport_, channels::kPolicyWeights, 4);
+}
+
+void TrainingSession::start_processes() {
+  const std::vector<std::string> transport_args = transport::transport_arguments(ctx_.rc.transport);
+  for (RoleSpec& role : make_roles(ctx_, transport_args)) supervisor_.add(std::move(role));
+  const fs::path proc_dir = fs::path(ctx_.run_dir) / "processes";
+  supervisor_.on_start([proc_dir](const std::string& name, int pid) {
+    // PID in the run's namespace, for tools and tests started in that namespace.
+    std::ofstream((proc_dir / (name + ".pid")).string()) << pid << "\n";
+  });
+  supervisor_.start_all();
+  out_ << "auvrl train: " << ctx_.actors << " actors on " << ctx_.cpus << " CPUs, "
+       << transport::describe(ctx_.rc.transport) << ", run " << ctx_.run_dir
+       << "\n  watch it: scripts/spy.sh " << ctx_.run_dir << "\n";
+}
+
+void TrainingSession::evaluate_newest_weights() {
+  if (clock_.now_s() < next_best_eval_s_) return;
+  next_best_eval_s_ = clock_.now_s() + ctx_.rc.run.best_eval_period_s;
+  const auto w = weights_->take();
+  if (!w || w->version == best_->best_version() || w->version <= 0) return;
+  try {
+    const nn::Mlp net = nn::network_from_bytes(
+        reinterpret_cast<const std::uint8_t*>(w->network.data()), w->network.size(), 1);
+    best_->consider(net, w->version, wall_s(), telemetry_.quick_eval);
+  } catch (const std::exception& e) {
+    out_ << "auvrl train: quick evaluation failed: " << e.what() << "\n";
+  }
+}
+
+std::string TrainingSession::status_line(double eta_s) const {
+  const double updates_per_s = figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0;
+  const std::string best_text =
+      best_->has_best() ? fmt::format("{}/{}", best_->best().reached, best_->best().episodes) : "-";
+  return fmt::format(
+      "episodes {}  success(100) {:.0f}%  beta {:.2f} m  env {:.0f} steps/s  updates {:.0f}/s  "
+      "best {}  elapsed {}  left {}",
+      figures_.learner_episodes, 100 * figures_.success_rate(), figures_.beta_m,
+      figures_.steps_per_s(), updates_per_s, best_text, format_duration(wall_s()),
+      format_duration(eta_s));
+}
+
+std::optional<std::string> TrainingSession::show_progress() {
+  if (clock_.now_s() < next_progress_s_) return std::nullopt;
+  next_progress_s_ = clock_.now_s() + 1.0;
+  double eta_s = -1;
+  if (ctx_.rc.run.max_train_s > 0) {
+    eta_s = ctx_.rc.run.max_train_s - wall_s();
+  } else if (ctx_.rc.learner_max_episodes > 0 && figures_.learner_episodes > 0) {
+    eta_s = static_cast<double>(ctx_.rc.learner_max_episodes - figures_.learner_episodes) *
+            ((clock_.now_s() - start_s_) / static_cast<double>(figures_.episodes_seen));
+  }
+  ProgressRow row{wall_s(),
+                  figures_.learner_episodes,
+                  figures_.success_rate(),
+                  figures_.beta_m,
+                  figures_.steps_per_s(),
+                  figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0,
+                  0.0};
+  if (best_->has_best()) {
+    row.best_suite_success = static_cast<double>(best_->best().reached) / best_->best().episodes;
+  }
+  telemetry_.progress.add(row);
+  if (auto error = telemetry_.flush()) return error;
+  if (tty_) {
+    out_ << "\r" << status_line(eta_s) << "   " << std::flush;
+  } else if (wall_s() - last_print_s_ >= 5.0) {
+    out_ << status_line(eta_s) << "\n";
+    last_print_s_ = wall_s();
+  }
+  return std::nullopt;
+}
+
+SupervisionOutcome TrainingSession::supervise_pass() {
+  transport_->handle(100);
+  if (signals::stop_requested()) return {true, 130, "stopped by the user"};
+  if (ctx_.rc.run.max_train_s > 0 && wall_s() >= ctx_.rc.run.max_train_s) {
+    return {true, 0,
+            fmt::format("training budget of {} used", format_duration(ctx_.rc.run.max_train_s))};
+  }
+  SupervisionOutcome outcome = supervisor_.poll();
+  if (outcome.stop) return outcome;
+  // Keep the best policy: evaluate the newest weights now and then.
+  evaluate_newest_weights();
+  if (auto error = show_progress()) return {true, 1, *error};
+  return {};
+}
+
+void TrainingSession::stop_processes() {
+  // Actors first (no more experience), then the learner (final checkpoint and policy), then
+  // the simulators and the logger (it flushes everything it received).
+  supervisor_.stop(RoleKind::kActor, 5);
+  supervisor_.stop(RoleKind::kLearner, 120);
+  supervisor_.stop(RoleKind::kSim, 5);
+  // Let the logger take in the last messages before it stops.
+  transport_->handle(200);
+  supervisor_.stop(RoleKind::kLogger, 10);
+  telemetry_.flush();
+}
+
+void TrainingSession::print_summary(int exit_code) {
+  const fs::path run_dir = ctx_.run_dir;
+  std::string best_text;
+  if (best_->has_best()) {
+    best_text =
+        fmt::format("  (best so far: policy_best.nn, {})",
+                    best_->best_version() == 0 ? std::string("from before the resume")
+                                               : fmt::format("version {}", best_->best_version()));
+  }
+  out_ << "auvrl train: run directory " << run_dir.string() << "\n"
+       << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
+       << "  policy       " << (run_dir / "policy.nn").string() << best_text << "\n"
+       << "  logs         " << (run_dir / "logs").string() << "\n";
+  if (exit_code != 0) out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+}
+
+TrainingResult TrainingSession::run() {
+  signals::install_stop_handlers();
+  subscribe();
+  start_processes();
+  // Supervise, show progress, keep the best policy.
+  next_progress_s_ = clock_.now_s();
+  next_best_eval_s_ = clock_.now_s() + ctx_.rc.run.best_eval_period_s;
+  best_ = std::make_unique<BestPolicyKeeper>(ctx_.model, ctx_.rc.task, ctx_.rc.run.best_eval_suite,
+                                             ctx_.rc.run.best_eval_max_hold_m, ctx_.run_dir);
+  if (ctx_.options.resume) best_->restore(out_);
+  SupervisionOutcome outcome;
+  while (!outcome.stop) outcome = supervise_pass();
+  if (tty_) out_ << "\n";
+  out_ << "auvrl train: " << outcome.stop_reason << "; stopping\n";
+  stop_processes();
+  print_summary(outcome.exit_code);
+  return {outcome.exit_code, std::move(best_)};
+}
+
+}  // namespace
+
+TrainingResult train(const RunContext& ctx, std::ostream& out) {
+  TrainingSession session(ctx, out);
+  return session.run();
+}
+
+}  // namespace auvrl::launcher

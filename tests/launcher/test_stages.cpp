@@ -1,0 +1,138 @@
+// The stages that run in process: the run directory and the processes' command lines.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "child_process.hpp"
+#include "launcher/launcher.hpp"
+#include "launcher/run_directory.hpp"
+#include "launcher/training.hpp"
+
+namespace auvrl::launcher {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool has(const std::vector<std::string>& argv, const std::vector<std::string>& run) {
+  return std::search(argv.begin(), argv.end(), run.begin(), run.end()) != argv.end();
+}
+
+TEST(RunDirectoryTest, ANewRunGetsItsFoldersAndAConfigCopyWithAnAbsoluteVehicle) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_rundir_");
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  const std::string config = prepare_run_directory(options);
+  EXPECT_EQ(config, (tmp / "run" / "config.yaml").string());
+  for (const char* sub : {"logs", "checkpoints", "eval", "plots", "processes"}) {
+    EXPECT_TRUE(fs::is_directory(tmp / "run" / sub)) << sub;
+  }
+  EXPECT_TRUE(fs::exists(tmp / "run" / "README.txt"));
+  std::ifstream in(config);
+  std::string line;
+  bool vehicle_absolute = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle: ", 0) == 0) vehicle_absolute = line.substr(9, 1) == "/";
+  }
+  EXPECT_TRUE(vehicle_absolute);
+  read_run_config(config);  // the copy reads
+  // A second new run there is refused; --resume takes it.
+  EXPECT_THROW(prepare_run_directory(options), std::runtime_error);
+  options.resume = true;
+  EXPECT_EQ(prepare_run_directory(options), config);
+  options.run_dir = (tmp / "none").string();
+  EXPECT_THROW(prepare_run_directory(options), std::runtime_error);
+}
+
+TEST(RunDirectoryTest, OnlyFinishedCheckpointsCount) {
+  const fs::path dir = test_support::make_temp_dir("auvrl_ckpt_");
+  EXPECT_FALSE(has_checkpoint_file(dir.string()));
+  std::ofstream(dir / "checkpoint-100.ckpt.tmp") << "x";
+  EXPECT_FALSE(has_checkpoint_file(dir.string()));
+  std::ofstream(dir / "checkpoint-100.ckpt") << "x";
+  EXPECT_TRUE(has_checkpoint_file(dir.string()));
+  EXPECT_FALSE(has_checkpoint_file((dir / "missing").string()));
+}
+
+class RolesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ctx.options.bin_dir = "/bin";
+    ctx.run_dir = test_support::make_temp_dir("auvrl_roles_");
+    fs::create_directories(fs::path(ctx.run_dir) / "checkpoints");
+    ctx.config_path = ctx.run_dir + "/config.yaml";
+    ctx.rc.vehicle_path = "/v.yaml";
+    ctx.rc.run.seed = 3;
+    ctx.cpus = 4;
+    ctx.actors = 2;
+  }
+  const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
+    for (const auto& r : roles) {
+      if (r.name == name) return r;
+    }
+    throw std::runtime_error("no role " + name);
+  }
+  RunContext ctx;
+};
+
+TEST_F(RolesTest, StartOrderKindsAndLogs) {
+  const auto roles = make_roles(ctx, {"--transport", "lcm"});
+  std::vector<std::string> names;
+  for (const auto& r : roles) names.push_back(r.name);
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"logger", "sim0", "sim1", "learner", "actor0", "actor1"}));
+  EXPECT_EQ(find(roles, "actor1").kind, RoleKind::kActor);
+  EXPECT_EQ(find(roles, "actor1").actor_id, 1);
+  EXPECT_EQ(find(roles, "learner").kind, RoleKind::kLearner);
+  EXPECT_EQ(find(roles, "sim0").log_path, ctx.run_dir + "/processes/sim0.log");
+  for (const auto& r : roles) {
+    const auto argv = r.argv(0);
+    EXPECT_EQ(argv[argv.size() - 2], "--transport") << r.name;
+  }
+}
+
+TEST_F(RolesTest, SimulatorsAndActorsShareACpuAndAPrivateBus) {
+  ctx.rc.run.learner_cpu = 0;
+  const auto roles = make_roles(ctx, {});
+  const auto sim1 = find(roles, "sim1").argv(0);
+  EXPECT_EQ(sim1[0], "/usr/bin/taskset");
+  EXPECT_EQ(sim1[2], "2");  // CPUs 1, 2, 3 left to the actors
+  EXPECT_TRUE(has(sim1, {"/bin/auv_sim", "--vehicle", "/v.yaml", "--vehicles", "1",
+                         "--first-vehicle-id", "1"}));
+  EXPECT_TRUE(
+      has(sim1, {"--lockstep-lcm-url", "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=1048576"}));
+  const auto actor1 = find(roles, "actor1").argv(0);
+  EXPECT_TRUE(has(actor1, {"--pin-cpu", "2"}));
+  EXPECT_TRUE(
+      has(actor1, {"--lockstep-lcm-url", "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=1048576"}));
+  const auto learner = find(roles, "learner").argv(0);
+  EXPECT_TRUE(has(learner, {"/usr/bin/taskset", "-c", "0", "/bin/auv_learner"}));
+}
+
+TEST_F(RolesTest, ARestartedActorGetsAnotherSeed) {
+  const auto roles = make_roles(ctx, {});
+  const RoleSpec& actor = find(roles, "actor1");
+  EXPECT_TRUE(has(actor.argv(0), {"--seed", "3001"}));
+  EXPECT_TRUE(has(actor.argv(2), {"--seed", std::to_string(3001 + 2 * 7919)}));
+  EXPECT_TRUE(has(actor.argv(0), {"/bin/auv_actor", "--config", ctx.config_path, "--actor-id", "1",
+                                  "--vehicle-id", "1"}));
+}
+
+TEST_F(RolesTest, TheLearnerResumesOnlyFromAFinishedCheckpoint) {
+  const auto roles = make_roles(ctx, {"--transport", "lcm"});
+  const RoleSpec& learner = find(roles, "learner");
+  auto argv = learner.argv(0);
+  EXPECT_EQ(std::count(argv.begin(), argv.end(), "--resume"), 0);
+  EXPECT_TRUE(has(argv, {"--seed", "3", "--transport", "lcm"}));
+  std::ofstream(ctx.run_dir + "/checkpoints/checkpoint-7.ckpt") << "x";
+  argv = learner.argv(1);
+  EXPECT_EQ(argv.back(), "--resume");
+  EXPECT_TRUE(has(argv, {"--max-actors", "2"}));
+}
+
+}  // namespace
+}  // namespace auvrl::launcher
