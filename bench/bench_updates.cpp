@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
   double seconds = 2.0;
   auvrl::cli::CommandLine cmd("bench_updates", "The learner's update rates, per case.");
   cmd.positional("SECONDS", &seconds, "measuring time per case", /*required=*/false);
-  cmd.app().get_option("SECONDS")->check(CLI::PositiveNumber);
+  cmd.check("SECONDS", auvrl::cli::positive());
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const auvrl::cli::UsageError& e) {

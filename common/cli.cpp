@@ -50,10 +50,33 @@ std::string describe(const CLI::ParseError& error, const CLI::App& root,
   if (no_subcommand) return fmt::format("a command is required (see {} --help)", program);
   const std::string what = error.what();
   if (what.rfind("--", 0) == 0) return "option " + what;
+  if (dynamic_cast<const CLI::ValidationError*>(&error) != nullptr) return "argument " + what;
   return what;
 }
 
 }  // namespace
+
+CLI::Validator at_least(double min) {
+  return CLI::Validator(
+      [min](std::string& text) {
+        double value = 0;
+        return CLI::detail::lexical_cast(text, value) && value >= min
+                   ? std::string()
+                   : fmt::format("expected a number >= {}, got '{}'", min, text);
+      },
+      "");
+}
+
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double value = 0;
+        return CLI::detail::lexical_cast(text, value) && value > 0
+                   ? std::string()
+                   : fmt::format("expected a number > 0, got '{}'", text);
+      },
+      "");
+}
 
 CommandLine::CommandLine(std::string program, std::string summary)
     : owned_(std::make_unique<CLI::App>(std::move(summary), program)),
@@ -122,10 +145,15 @@ void CommandLine::choices(const std::string& name, const std::vector<std::string
   app_->get_option("--" + name)->check(CLI::IsMember(values));
 }
 
-void CommandLine::require(const std::string& name) {
+CLI::Option* CommandLine::find(const std::string& name) {
   CLI::Option* option = app_->get_option_no_throw("--" + name);
-  if (option == nullptr) option = app_->get_option(name);  // a positional; throws if unknown
-  option->required();
+  return option != nullptr ? option : app_->get_option(name);  // a positional; throws if unknown
+}
+
+void CommandLine::require(const std::string& name) { find(name)->required(); }
+
+void CommandLine::check(const std::string& name, const CLI::Validator& validator) {
+  find(name)->check(validator);
 }
 
 CommandLine& CommandLine::subcommand(const std::string& name, const std::string& summary) {

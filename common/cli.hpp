@@ -50,6 +50,11 @@ CLI::Option* checked(CLI::Option* option) {
 
 }  // namespace detail
 
+/// A CLI11 check: a number >= min ("expected a number >= 8, got '4'").
+CLI::Validator at_least(double min);
+/// A CLI11 check: a number > 0.
+CLI::Validator positive();
+
 /// Declares options bound to variables (a target's value before parse() is its default), then
 /// parses argv into them. Holds a CLI::App, reachable through app() for what this API lacks.
 /// A subcommand is a CommandLine of its own, owned by its parent and parsed with it.
@@ -76,6 +81,9 @@ class CommandLine {
   /// --name VALUE that may be given several times; every value is appended to *target.
   void repeatable(const std::string& name, std::vector<std::string>* target,
                   const std::string& help);
+  /// Adds a CLI11 check (at_least(), positive(), CLI::ExistingFile, ...) to the declared option
+  /// --name (or positional NAME).
+  void check(const std::string& name, const CLI::Validator& validator);
   /// Restricts the declared option --name to one of values (CLI11's IsMember check).
   void choices(const std::string& name, const std::vector<std::string>& values);
   /// Makes the declared option --name (or positional NAME) required.
@@ -131,6 +139,8 @@ class CommandLine {
   const CLI::App& app() const { return *app_; }
 
  private:
+  /// The declared option --name, or else positional NAME.
+  CLI::Option* find(const std::string& name);
   /// A subcommand's CommandLine on app, owned by its parent.
   CommandLine(CLI::App* app, std::string program);
 

@@ -94,7 +94,7 @@ void declare_modes(cli::CommandLine& cmd, Args& a) {
   publish.positional("CHANNEL", &a.channel, "channel to publish on");
   publish.positional("N", &a.count, "messages (versions 1..N in their first 8 bytes)");
   publish.positional("SIZE", &a.size, "bytes per message (at least 8: the version)");
-  publish.app().get_option("SIZE")->check(CLI::Range(8.0, 1e9));
+  publish.check("SIZE", cli::at_least(8));
   cmd.require_subcommand();
 }
 

@@ -41,10 +41,8 @@ int main(int argc, char** argv) {
   cmd.option("episode", &episode_s, "reset each vehicle this often, s");
   cmd.option("types-dir", &types_dir, "directory of the .lcm files");
   cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
-  cmd.app().get_option("--vehicles")->check(CLI::NonNegativeNumber);
-  for (const char* name : {"--rate", "--sample-period", "--episode"}) {
-    cmd.app().get_option(name)->check(CLI::PositiveNumber);
-  }
+  cmd.check("vehicles", cli::at_least(0));
+  for (const char* name : {"rate", "sample-period", "episode"}) cmd.check(name, cli::positive());
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {

@@ -69,7 +69,8 @@ struct Args {
 /// A --name TIME / FRACTION option parsed by the schedule's own parser (which knows the units),
 /// its errors reported as CLI11's.
 void add_unit_option(CLI::App& app, const std::string& name, double* target,
-                     double (*parse)(const std::string&), const std::string& help) {
+                     double (*parse)(const std::string&), const std::string& default_text,
+                     const std::string& help) {
   app.add_option_function<std::string>(
          name,
          [name, target, parse](const std::string& text) {
@@ -80,7 +81,7 @@ void add_unit_option(CLI::App& app, const std::string& name, double* target,
            }
          },
          help)
-      ->default_str(std::to_string(*target));
+      ->default_str(default_text);
 }
 
 /// Parses argv with CLI11; exits with 0 after --help and 2 on a bad command line.
@@ -91,15 +92,17 @@ Args parse_args(int argc, char** argv) {
       "jitter] (>= 0), or drops it with probability loss. Inside a private network namespace "
       "only (see scripts/netem.sh).",
       "auv_netdelay");
-  app.option_defaults()->always_capture_default();
   app.add_option("--queue", a.queue_num, "NFQUEUE queue number")
       ->required()
       ->check(CLI::Range(0, 65535));
-  add_unit_option(app, "--delay", &a.options.delay_ms, parse_ms, "mean delay, e.g. 5ms, 500us");
-  add_unit_option(app, "--jitter", &a.options.jitter_ms, parse_ms, "delay +- this, uniform");
-  add_unit_option(app, "--loss", &a.options.loss, parse_fraction, "drop probability, 10% or 0.1");
-  app.add_option("--seed", a.options.seed, "seed of the draws");
-  app.add_option("--max-queued", a.max_queued, "the kernel queue's bound (fail-open beyond)");
+  add_unit_option(app, "--delay", &a.options.delay_ms, parse_ms, "0ms",
+                  "mean delay, e.g. 5ms, 500us");
+  add_unit_option(app, "--jitter", &a.options.jitter_ms, parse_ms, "0ms", "delay +- this, uniform");
+  add_unit_option(app, "--loss", &a.options.loss, parse_fraction, "0%",
+                  "drop probability, 10% or 0.1");
+  app.add_option("--seed", a.options.seed, "seed of the draws")->capture_default_str();
+  app.add_option("--max-queued", a.max_queued, "the kernel queue's bound (fail-open beyond)")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
