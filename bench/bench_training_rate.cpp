@@ -138,14 +138,11 @@ int main(int argc, char** argv) {
   cmd.option("updates-per-transition", &ratio, "the learner's update ratio");
   std::string which = "both";
   cmd.option("transport", &which, "lcm, dds or both (one after the other, same run)");
+  cmd.choices("transport", {"lcm", "dds", "both"});
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
-    return 2;
-  }
-  if (which != "lcm" && which != "dds" && which != "both") {
-    std::cerr << "bench_training_rate: --transport: expected lcm, dds or both\n";
     return 2;
   }
   for (bool pinned : {false, true}) {

@@ -2,15 +2,24 @@
 // DDPG and TD3, and the same with pendulum dims (state 3, action 1), as RLtools reports them;
 // then the fast preset's learner without and with the PID imitation term, alternated three
 // times (the machine is shared), and the ratio of their rates.
-// Usage: bench_updates [seconds per case]. Not a CTest test.
-#include <cstdlib>
+// Usage: bench_updates [SECONDS per case]. Not a CTest test.
 #include <iostream>
 
+#include "common/cli.hpp"
 #include "learner/bench.hpp"
 
 int main(int argc, char** argv) {
   using namespace auvrl::learner;
-  const double seconds = argc > 1 ? std::atof(argv[1]) : 2.0;
+  double seconds = 2.0;
+  auvrl::cli::CommandLine cmd("bench_updates", "The learner's update rates, per case.");
+  cmd.positional("SECONDS", &seconds, "measuring time per case", /*required=*/false);
+  cmd.check("SECONDS", auvrl::cli::positive());
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+  } catch (const auvrl::cli::UsageError& e) {
+    std::cerr << "bench_updates: " << e.what() << "\n";
+    return 2;
+  }
   for (Algo algo : {Algo::kDdpg, Algo::kTd3}) {
     for (BenchCase c : standard_bench_cases(algo)) {
       c.seconds = seconds;

@@ -199,6 +199,7 @@ int main(int argc, char** argv) {
   cmd.option("hidden", &hidden_list, "comma-separated actor sizes");
   std::string which = "both";
   cmd.option("transport", &which, "lcm, dds or both (one after the other, same run)");
+  cmd.choices("transport", {"lcm", "dds", "both"});
   std::string late_joiner_path;
   cmd.option("late-joiner", &late_joiner_path,
              "(internal) be the late joiner over --transport, write the result here");
@@ -206,10 +207,6 @@ int main(int argc, char** argv) {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
-    return 2;
-  }
-  if (which != "lcm" && which != "dds" && which != "both") {
-    std::cerr << "bench_weights: --transport: expected lcm, dds or both\n";
     return 2;
   }
   if (!late_joiner_path.empty()) {

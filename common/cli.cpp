@@ -1,145 +1,233 @@
 #include "common/cli.hpp"
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
+#include <fmt/format.h>
+
 #include <iostream>
-#include <sstream>
+#include <utility>
 
 namespace auvrl::cli {
 
 namespace {
 
-std::int64_t parse_integer(const std::string& name, const std::string& text) {
-  errno = 0;
-  char* end = nullptr;
-  const long long value = std::strtoll(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || errno == ERANGE) {
-    throw UsageError("option --" + name + ": expected an integer, got '" + text + "'");
+/// What every option of a command line shares: --help shows the target's value before parse()
+/// as the default; an option given twice keeps the last value (launchers append overrides).
+void configure(CLI::App& app) {
+  app.option_defaults()->always_capture_default()->multi_option_policy(
+      CLI::MultiOptionPolicy::TakeLast);
+  app.get_formatter()->column_width(34);
+}
+
+/// Whether app declares subcommands and none was given.
+bool subcommand_missing(const CLI::App& app) {
+  return app.get_subcommands().empty() &&
+         !app.get_subcommands([](const CLI::App*) { return true; }).empty();
+}
+
+/// The first argument CLI11 could not place, as an error that says what it is.
+std::string describe_extra(const CLI::App& root, const std::string& program) {
+  const std::vector<std::string> extras = root.remaining(true);
+  if (extras.empty()) return "unexpected arguments";
+  const std::string& first = extras.front();
+  if (first.size() > 1 && first[0] == '-') {
+    return fmt::format("unknown option {} (see {} --help)", first.substr(0, first.find('=')),
+                       program);
   }
-  return value;
+  if (subcommand_missing(root)) {
+    return fmt::format("unknown command '{}' (see {} --help)", first, program);
+  }
+  return fmt::format("unexpected argument '{}'", first);
+}
+
+/// CLI11's error as this project words it: "option --name: what was wrong".
+std::string describe(const CLI::ParseError& error, const CLI::App& root,
+                     const std::string& program) {
+  const bool no_subcommand =
+      dynamic_cast<const CLI::RequiredError*>(&error) != nullptr && subcommand_missing(root);
+  if (dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr ||
+      (no_subcommand && !root.remaining(true).empty())) {
+    return describe_extra(root, program);
+  }
+  if (no_subcommand) return fmt::format("a command is required (see {} --help)", program);
+  const std::string what = error.what();
+  if (what.rfind("--", 0) == 0) return "option " + what;
+  if (dynamic_cast<const CLI::ValidationError*>(&error) != nullptr) return "argument " + what;
+  return what;
 }
 
 }  // namespace
 
-CommandLine::CommandLine(std::string program, std::string summary)
-    : program_(std::move(program)), summary_(std::move(summary)) {}
+CLI::Validator at_least(double min) {
+  return CLI::Validator(
+      [min](std::string& text) {
+        double value = 0;
+        return CLI::detail::lexical_cast(text, value) && value >= min
+                   ? std::string()
+                   : fmt::format("expected a number >= {}, got '{}'", min, text);
+      },
+      "");
+}
 
-void CommandLine::add(Option option) { options_.push_back(std::move(option)); }
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double value = 0;
+        return CLI::detail::lexical_cast(text, value) && value > 0
+                   ? std::string()
+                   : fmt::format("expected a number > 0, got '{}'", text);
+      },
+      "");
+}
+
+CommandLine::CommandLine(std::string program, std::string summary)
+    : owned_(std::make_unique<CLI::App>(std::move(summary), program)),
+      app_(owned_.get()),
+      program_(std::move(program)) {
+  configure(*app_);
+}
+
+CommandLine::CommandLine(CLI::App* app, std::string program)
+    : app_(app), program_(std::move(program)) {}
+
+CommandLine::CommandLine(CommandLine&&) noexcept = default;
+CommandLine& CommandLine::operator=(CommandLine&&) noexcept = default;
+CommandLine::~CommandLine() = default;
 
 void CommandLine::flag(const std::string& name, bool* target, const std::string& help) {
-  add({name, help, "", false, [target](const std::string&) { *target = true; }});
-}
-
-void CommandLine::option(const std::string& name, std::string* target, const std::string& help) {
-  add({name, help, *target, true, [target](const std::string& v) { *target = v; }});
-}
-
-void CommandLine::option(const std::string& name, int* target, const std::string& help) {
-  add({name, help, std::to_string(*target), true, [target, name](const std::string& v) {
-         const std::int64_t value = parse_integer(name, v);
-         if (value < INT32_MIN || value > INT32_MAX) {
-           throw UsageError("option --" + name + ": " + v + " is out of range");
-         }
-         *target = static_cast<int>(value);
-       }});
-}
-
-void CommandLine::option(const std::string& name, std::int64_t* target, const std::string& help) {
-  add({name, help, std::to_string(*target), true,
-       [target, name](const std::string& v) { *target = parse_integer(name, v); }});
-}
-
-void CommandLine::option(const std::string& name, double* target, const std::string& help) {
-  std::ostringstream default_text;
-  default_text << *target;
-  add({name, help, default_text.str(), true, [target, name](const std::string& v) {
-         char* end = nullptr;
-         const double value = std::strtod(v.c_str(), &end);
-         if (v.empty() || *end != '\0' || !std::isfinite(value)) {
-           throw UsageError("option --" + name + ": expected a finite number, got '" + v + "'");
-         }
-         *target = value;
-       }});
+  app_->add_flag("--" + name, *target, help)->disable_flag_override();
 }
 
 void CommandLine::custom_flag(const std::string& name, std::function<void()> set,
                               const std::string& help) {
-  add({name, help, "", false, [set = std::move(set)](const std::string&) { set(); }});
+  app_->add_flag_callback("--" + name, std::move(set), help)
+      ->disable_flag_override()
+      ->trigger_on_parse();
 }
 
 void CommandLine::custom_option(const std::string& name,
                                 std::function<void(const std::string&)> parse,
                                 const std::string& default_text, const std::string& help) {
-  add({name, help, default_text, true, [parse = std::move(parse), name](const std::string& v) {
-         try {
-           parse(v);
-         } catch (const UsageError&) {
-           throw;
-         } catch (const std::exception& e) {
-           throw UsageError("option --" + name + ": " + e.what());
-         }
-       }});
+  const std::string option = "--" + name;
+  // Called as each occurrence is parsed (in argv order, as the parse functions expect).
+  app_->add_option_function<std::string>(
+          option,
+          [parse = std::move(parse), option](const std::string& value) {
+            try {
+              parse(value);
+            } catch (const UsageError&) {
+              throw;
+            } catch (const std::exception& e) {
+              throw UsageError(fmt::format("option {}: {}", option, e.what()));
+            }
+          },
+          help)
+      ->default_str(default_text)
+      ->trigger_on_parse();
+}
+
+void CommandLine::repeatable(const std::string& name, std::vector<std::string>* target,
+                             const std::string& help) {
+  // One value per occurrence (CLI11 lets a vector option take several), all of them kept.
+  app_->add_option("--" + name, *target, help)
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->default_str("");  // not "[]"
+}
+
+void CommandLine::positionals(const std::string& name, std::vector<std::string>* target,
+                              const std::string& help, bool required) {
+  app_->add_option(name, *target, help)
+      ->required(required)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->default_str("");  // not "[]"
+}
+
+void CommandLine::choices(const std::string& name, const std::vector<std::string>& values) {
+  app_->get_option("--" + name)->check(CLI::IsMember(values));
+}
+
+CLI::Option* CommandLine::find(const std::string& name) {
+  CLI::Option* option = app_->get_option_no_throw("--" + name);
+  return option != nullptr ? option : app_->get_option(name);  // a positional; throws if unknown
+}
+
+void CommandLine::require(const std::string& name) { find(name)->required(); }
+
+void CommandLine::check(const std::string& name, const CLI::Validator& validator) {
+  find(name)->check(validator);
+}
+
+CommandLine& CommandLine::subcommand(const std::string& name, const std::string& summary) {
+  CLI::App* app = app_->add_subcommand(name, summary);
+  subcommands_.push_back(std::unique_ptr<CommandLine>(new CommandLine(app, program_ + " " + name)));
+  return *subcommands_.back();
+}
+
+CommandLine& CommandLine::subcommand(const std::string& name) {
+  for (const auto& sub : subcommands_) {
+    if (sub->app_->get_name() == name) return *sub;
+  }
+  throw std::out_of_range("no subcommand " + name + " of " + program_);
+}
+
+void CommandLine::require_subcommand() { app_->require_subcommand(1); }
+
+std::string CommandLine::chosen() const {
+  const auto chosen = app_->get_subcommands();
+  return chosen.empty() ? "" : chosen.front()->get_name();
+}
+
+void CommandLine::pass_on_rest() {
+  app_->prefix_command();
+  app_->set_help_flag();  // --help goes to the handler too
+}
+
+CommandLine::Rest CommandLine::rest() const {
+  Rest rest;
+  rest.args.push_back(program_);
+  for (std::string& arg : app_->remaining()) rest.args.push_back(std::move(arg));
+  for (const std::string& arg : rest.args) rest.pointers.push_back(arg.c_str());
+  return rest;
 }
 
 bool CommandLine::parse(int argc, const char* const* argv) {
-  for (int i = 1; i < argc; ++i) {
-    std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << usage();
-      return false;
+  try {
+    app_->parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << usage();
+    return false;
+  } catch (const CLI::ParseError& e) {
+    // "see auv_log list --help" when the error is in a subcommand's options.
+    std::string program = program_;
+    for (const CLI::App* app = app_; !app->get_subcommands().empty();) {
+      app = app->get_subcommands().front();
+      program += " " + app->get_name();
     }
-    if (arg.rfind("--", 0) != 0) throw UsageError("unexpected argument '" + arg + "'");
-    std::string name = arg.substr(2);
-    std::string value;
-    bool has_inline_value = false;
-    if (const auto eq = name.find('='); eq != std::string::npos) {
-      value = name.substr(eq + 1);
-      name = name.substr(0, eq);
-      has_inline_value = true;
-    }
-    const Option* match = nullptr;
-    for (const Option& option : options_) {
-      if (option.name == name) match = &option;
-    }
-    if (match == nullptr) {
-      throw UsageError("unknown option --" + name + " (see " + program_ + " --help)");
-    }
-    if (match->takes_value && !has_inline_value) {
-      if (i + 1 >= argc) throw UsageError("option --" + name + " needs a value");
-      value = argv[++i];
-    } else if (!match->takes_value && has_inline_value) {
-      throw UsageError("option --" + name + " takes no value");
-    }
-    match->apply(value);
+    throw UsageError(describe(e, *app_, program));
   }
   return true;
 }
 
-std::string CommandLine::find_value(int argc, const char* const* argv, const std::string& name) {
-  const std::string flag = "--" + name;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == flag && i + 1 < argc) return argv[i + 1];
-    if (arg.rfind(flag + "=", 0) == 0) return arg.substr(flag.size() + 1);
-  }
-  return "";
+std::string CommandLine::usage() const {
+  // A subcommand's usage line starts with its parent's name ("auv_log list").
+  const auto space = program_.rfind(' ');
+  return owned_ != nullptr
+             ? app_->help()
+             : app_->help(space == std::string::npos ? "" : program_.substr(0, space));
 }
 
-std::string CommandLine::usage() const {
-  std::ostringstream out;
-  out << "usage: " << program_ << " [options]\n" << summary_ << "\n\noptions:\n";
-  for (const Option& option : options_) {
-    std::string left = "  --" + option.name + (option.takes_value ? " VALUE" : "");
-    out << left;
-    out << std::string(left.size() < 30 ? 30 - left.size() : 1, ' ') << option.help;
-    if (option.takes_value && !option.default_text.empty()) {
-      out << " (default: " << option.default_text << ")";
-    }
-    out << '\n';
+std::string CommandLine::find_value(int argc, const char* const* argv, const std::string& name) {
+  // A throwaway CLI11 app that knows only --name and lets everything else through.
+  CLI::App app;
+  app.allow_extras();
+  app.set_help_flag();
+  std::string value;
+  app.add_option("--" + name, value)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError&) {
+    return "";  // --name without a value: parse() reports it
   }
-  out << "  --help                      this text\n";
-  return out.str();
+  return value;
 }
 
 }  // namespace auvrl::cli

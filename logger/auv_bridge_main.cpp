@@ -4,10 +4,10 @@
 #include <chrono>
 #include <iostream>
 
+#include "common/cli.hpp"
 #include "common/signals.hpp"
 #include "common/transport_options.hpp"
 #include "logger/bridge.hpp"
-#include "logger/command_line.hpp"
 
 int main(int argc, char** argv) {
   using namespace auvrl;
@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
   logger::BridgeConfig config;
   double report_period_s = 10.0;
 
-  logger::ToolCommandLine cmd(
+  cli::CommandLine cmd(
       "auv_bridge",
       "Forwards the channels matching --channels from one transport to the other, the same "
       "bytes on the same channel names (DDS to LCM: lcm-spy and lcm-logger watch a DDS run). "
@@ -31,9 +31,6 @@ int main(int argc, char** argv) {
   transport::TransportConfig source, destination;
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    if (!cmd.positional().empty()) {
-      throw cli::UsageError("unexpected argument '" + cmd.positional().front() + "'");
-    }
     source = destination = transport_config;
     source.kind = transport::parse_transport_kind(from);
     destination.kind = transport::parse_transport_kind(to);

@@ -4,10 +4,10 @@
 #include <iostream>
 #include <memory>
 
+#include "common/cli.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
-#include "logger/command_line.hpp"
 #include "logger/logger.hpp"
 #include "logger/schema.hpp"
 
@@ -18,13 +18,14 @@ int main(int argc, char** argv) {
   std::vector<std::string> throttles;
   std::string types_dir = logger::default_types_dir();
 
-  logger::ToolCommandLine cmd(
+  cli::CommandLine cmd(
       "auv_logger",
       "Writes the traffic of the transport (LCM or DDS; every channel, or those matching "
       "--channels) into LCM event logs "
       "(lcm-logger's format) in --dir, rotating by size, and publishes counts on " +
           channels::kLoggerHeartbeat + ".");
   cmd.option("dir", &config.dir, "directory of the log files (created if missing)");
+  cmd.require("dir");
   cmd.option("prefix", &config.prefix, "log files are PREFIX-NNNN.lcmlog");
   cmd.option("channels", &config.channels, "full-match regex of the channels to log");
   cmd.option("max-file-mb", &config.max_file_mb, "start a new file before one exceeds this, MB");
@@ -39,10 +40,6 @@ int main(int argc, char** argv) {
   transport::add_transport_options(cmd, transport_config);
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    if (!cmd.positional().empty()) {
-      throw cli::UsageError("unexpected argument '" + cmd.positional().front() + "'");
-    }
-    if (config.dir.empty()) throw cli::UsageError("--dir is required (where to write the logs)");
     for (const std::string& text : throttles) {
       config.throttles.push_back(logger::parse_throttle_rule(text));
     }

@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   cmd.option("open-loop", &open_loop_in, "open-loop tool: input CSV t,f1..fN (N)");
   cmd.option("out", &open_loop_out, "open-loop tool: output CSV");
   cmd.flag("ideal-thrusters", &ideal_thrusters, "open-loop tool: no thruster delay, lag or slew");
+  cmd.app().get_option("--open-loop")->needs("--out");
+  cmd.app().get_option("--out")->needs("--open-loop");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
@@ -43,10 +45,6 @@ int main(int argc, char** argv) {
   }
 
   if (!open_loop_in.empty() || !open_loop_out.empty()) {
-    if (open_loop_in.empty() || open_loop_out.empty()) {
-      std::cerr << "auv_sim: --open-loop and --out go together\n";
-      return 2;
-    }
     sim::OpenLoopOptions options;
     options.vehicle_path = vehicle_path;
     options.input_csv = open_loop_in;

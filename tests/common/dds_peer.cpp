@@ -10,11 +10,13 @@
 //                                      first 8 bytes), then stays until SIGTERM (a transient-
 //                                      local writer's history lives as long as its process)
 #include <chrono>
+#include <cstdint>
 #include <cstring>
 #include <iostream>
 #include <string>
 #include <vector>
 
+#include "common/cli.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
 
@@ -29,13 +31,83 @@ std::int64_t version_of(const transport::RawMessage& m) {
   return v;
 }
 
+/// The command line of every mode (one subcommand each).
+struct Args {
+  std::string regex, channel;
+  int timeout_ms = 0;
+  std::int64_t count = 0;
+  std::size_t size = 0;
+};
+
+int run_echo(transport::Transport& t, const Args& a) {
+  t.subscribe(a.regex,
+              [&](const transport::RawMessage& m) { t.publish(a.channel, m.data, m.size); });
+  std::cout << "ready" << std::endl;
+  while (!signals::stop_requested()) t.handle(50);
+  return 0;
+}
+
+int run_latest(transport::Transport& t, const Args& a) {
+  const auto start = Clock::now();
+  double first_ms = -1;
+  std::int64_t count = 0, version = 0;
+  std::size_t size = 0;
+  t.subscribe(a.channel, [&](const transport::RawMessage& m) {
+    if (count++ == 0) {
+      first_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+      version = version_of(m);
+      size = m.size;
+    }
+  });
+  const auto deadline = start + std::chrono::milliseconds(a.timeout_ms);
+  while (count == 0 && Clock::now() < deadline) t.handle_one(10);
+  const auto settle = Clock::now() + std::chrono::milliseconds(200);
+  while (Clock::now() < settle) t.handle(10);
+  std::cout << "first_ms=" << first_ms << " count=" << count << " size=" << size
+            << " version=" << version << std::endl;
+  return count > 0 ? 0 : 1;
+}
+
+int run_publish(transport::Transport& t, const Args& a) {
+  std::vector<std::uint8_t> bytes(a.size, 0x5a);
+  for (std::int64_t v = 1; v <= a.count; ++v) {
+    std::memcpy(bytes.data(), &v, sizeof v);
+    t.publish(a.channel, bytes.data(), bytes.size());
+  }
+  std::cout << "published " << a.count << std::endl;
+  while (!signals::stop_requested()) t.handle(50);
+  return 0;
+}
+
+/// Declares the three modes on cmd, bound to a.
+void declare_modes(cli::CommandLine& cmd, Args& a) {
+  cli::CommandLine& echo =
+      cmd.subcommand("echo", "republish what matches REGEX on CHANNEL until SIGTERM");
+  echo.positional("REGEX", &a.regex, "full-match regex of the channels to echo");
+  echo.positional("CHANNEL", &a.channel, "channel to republish on");
+  cli::CommandLine& latest =
+      cmd.subcommand("latest", "wait for the first message on CHANNEL, print what came");
+  latest.positional("CHANNEL", &a.channel, "channel to subscribe to");
+  latest.positional("TIMEOUT_MS", &a.timeout_ms, "how long to wait for the first message, ms");
+  cli::CommandLine& publish =
+      cmd.subcommand("publish", "publish N messages on CHANNEL, then stay until SIGTERM");
+  publish.positional("CHANNEL", &a.channel, "channel to publish on");
+  publish.positional("N", &a.count, "messages (versions 1..N in their first 8 bytes)");
+  publish.positional("SIZE", &a.size, "bytes per message (at least 8: the version)");
+  publish.check("SIZE", cli::at_least(8));
+  cmd.require_subcommand();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty()) {
-    std::cerr << "usage: dds_peer echo REGEX CHANNEL | latest CHANNEL TIMEOUT_MS | publish "
-                 "CHANNEL N SIZE\n";
+  cli::CommandLine cmd("dds_peer", "A second process for the DDS transport tests.");
+  Args args;
+  declare_modes(cmd, args);
+  try {
+    if (!cmd.parse(argc, argv)) return 0;
+  } catch (const cli::UsageError& e) {
+    std::cerr << "dds_peer: " << e.what() << "\n";
     return 2;
   }
   try {
@@ -43,47 +115,10 @@ int main(int argc, char** argv) {
     transport::TransportConfig config;
     config.kind = transport::TransportKind::kDds;
     auto t = transport::make_transport(config);
-    if (args[0] == "echo" && args.size() == 3) {
-      const std::string out = args[2];
-      t->subscribe(args[1],
-                   [&](const transport::RawMessage& m) { t->publish(out, m.data, m.size); });
-      std::cout << "ready" << std::endl;
-      while (!signals::stop_requested()) t->handle(50);
-      return 0;
-    }
-    if (args[0] == "latest" && args.size() == 3) {
-      const auto start = Clock::now();
-      double first_ms = -1;
-      std::int64_t count = 0, version = 0;
-      std::size_t size = 0;
-      t->subscribe(args[1], [&](const transport::RawMessage& m) {
-        if (count++ == 0) {
-          first_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-          version = version_of(m);
-          size = m.size;
-        }
-      });
-      const auto deadline = start + std::chrono::milliseconds(std::stoi(args[2]));
-      while (count == 0 && Clock::now() < deadline) t->handle_one(10);
-      const auto settle = Clock::now() + std::chrono::milliseconds(200);
-      while (Clock::now() < settle) t->handle(10);
-      std::cout << "first_ms=" << first_ms << " count=" << count << " size=" << size
-                << " version=" << version << std::endl;
-      return count > 0 ? 0 : 1;
-    }
-    if (args[0] == "publish" && args.size() == 4) {
-      const int n = std::stoi(args[2]);
-      std::vector<std::uint8_t> bytes(std::stoul(args[3]), 0x5a);
-      for (std::int64_t v = 1; v <= n; ++v) {
-        std::memcpy(bytes.data(), &v, sizeof v);
-        t->publish(args[1], bytes.data(), bytes.size());
-      }
-      std::cout << "published " << n << std::endl;
-      while (!signals::stop_requested()) t->handle(50);
-      return 0;
-    }
-    std::cerr << "dds_peer: bad arguments\n";
-    return 2;
+    const std::string mode = cmd.chosen();
+    if (mode == "echo") return run_echo(*t, args);
+    if (mode == "latest") return run_latest(*t, args);
+    return run_publish(*t, args);
   } catch (const std::exception& e) {
     std::cerr << "dds_peer: " << e.what() << "\n";
     return 1;

@@ -41,11 +41,10 @@ int main(int argc, char** argv) {
   cmd.option("episode", &episode_s, "reset each vehicle this often, s");
   cmd.option("types-dir", &types_dir, "directory of the .lcm files");
   cmd.option("lcm-url", &transport_config.lcm_url, "LCM URL");
+  cmd.check("vehicles", cli::at_least(0));
+  for (const char* name : {"rate", "sample-period", "episode"}) cmd.check(name, cli::positive());
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    if (vehicles < 0 || !(rate_hz > 0.0) || !(sample_period_s > 0.0) || !(episode_s > 0.0)) {
-      throw cli::UsageError("--vehicles >= 0, --rate, --sample-period and --episode > 0 expected");
-    }
   } catch (const cli::UsageError& e) {
     std::cerr << "logger_demo_traffic: " << e.what() << "\n";
     return 2;

@@ -17,6 +17,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -58,48 +59,69 @@ void accept_all(Context& ctx, const std::vector<std::uint32_t>& ids) {
   }
 }
 
-[[noreturn]] void usage(const char* why) {
-  if (why != nullptr) std::fprintf(stderr, "auv_netdelay: %s\n", why);
-  std::fprintf(stderr,
-               "usage: auv_netdelay --queue N [--delay 5ms] [--jitter 5ms] [--loss 10%%]\n"
-               "                    [--seed 1] [--max-queued 4096]\n"
-               "Holds each packet of NFQUEUE queue N for a delay uniform in [delay - jitter,\n"
-               "delay + jitter] (>= 0), or drops it with probability loss. Inside a private\n"
-               "network namespace only (see scripts/netem.sh).\n");
-  std::exit(2);
+/// The command line: the impairment, the queue and its bound.
+struct Args {
+  DelayOptions options;
+  long queue_num = -1;
+  unsigned max_queued = 4096;
+};
+
+/// A --name TIME / FRACTION option parsed by the schedule's own parser (which knows the units),
+/// its errors reported as CLI11's.
+void add_unit_option(CLI::App& app, const std::string& name, double* target,
+                     double (*parse)(const std::string&), const std::string& default_text,
+                     const std::string& help) {
+  app.add_option_function<std::string>(
+         name,
+         [name, target, parse](const std::string& text) {
+           try {
+             *target = parse(text);
+           } catch (const std::invalid_argument& e) {
+             throw CLI::ValidationError(name, e.what());
+           }
+         },
+         help)
+      ->default_str(default_text);
+}
+
+/// Parses argv with CLI11; exits with 0 after --help and 2 on a bad command line.
+Args parse_args(int argc, char** argv) {
+  Args a;
+  CLI::App app(
+      "Holds each packet of NFQUEUE queue N for a delay uniform in [delay - jitter, delay + "
+      "jitter] (>= 0), or drops it with probability loss. Inside a private network namespace "
+      "only (see scripts/netem.sh).",
+      "auv_netdelay");
+  app.add_option("--queue", a.queue_num, "NFQUEUE queue number")
+      ->required()
+      ->check(CLI::Range(0, 65535));
+  add_unit_option(app, "--delay", &a.options.delay_ms, parse_ms, "0ms",
+                  "mean delay, e.g. 5ms, 500us");
+  add_unit_option(app, "--jitter", &a.options.jitter_ms, parse_ms, "0ms", "delay +- this, uniform");
+  add_unit_option(app, "--loss", &a.options.loss, parse_fraction, "0%",
+                  "drop probability, 10% or 0.1");
+  app.add_option("--seed", a.options.seed, "seed of the draws")->capture_default_str();
+  app.add_option("--max-queued", a.max_queued, "the kernel queue's bound (fail-open beyond)")
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::fputs(app.help().c_str(), stdout);
+    std::exit(0);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "auv_netdelay: %s (see auv_netdelay --help)\n", e.what());
+    std::exit(2);
+  }
+  return a;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  DelayOptions options;
-  long queue_num = -1;
-  unsigned max_queued = 4096;
-  try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      if (arg == "-h" || arg == "--help") usage(nullptr);
-      if (i + 1 >= argc) usage(("missing value after " + arg).c_str());
-      const std::string value = argv[++i];
-      if (arg == "--queue")
-        queue_num = std::stol(value);
-      else if (arg == "--delay")
-        options.delay_ms = parse_ms(value);
-      else if (arg == "--jitter")
-        options.jitter_ms = parse_ms(value);
-      else if (arg == "--loss")
-        options.loss = parse_fraction(value);
-      else if (arg == "--seed")
-        options.seed = std::stoull(value);
-      else if (arg == "--max-queued")
-        max_queued = static_cast<unsigned>(std::stoul(value));
-      else
-        usage(("unknown option " + arg).c_str());
-    }
-  } catch (const std::exception& e) {
-    usage(e.what());
-  }
-  if (queue_num < 0 || queue_num > 65535) usage("--queue N (0..65535) is required");
+  const Args args = parse_args(argc, argv);
+  const DelayOptions& options = args.options;
+  const long queue_num = args.queue_num;
+  const unsigned max_queued = args.max_queued;
 
   nfq_handle* handle = nfq_open();
   if (handle == nullptr) {
