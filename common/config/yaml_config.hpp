@@ -44,6 +44,7 @@ class Section {
   Section child(const std::string& key);
   /// Marks keys as known without reading them (sections other processes read).
   void ignore(std::initializer_list<const char*> keys);
+  void ignore_key(const std::string& key) { read_.insert(key); }
   /// Throws ConfigError for any key nobody read.
   void finish() const;
 
