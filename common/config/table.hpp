@@ -100,7 +100,7 @@ class Table {
   Table& choice(const std::string& key, Access access, E (*parse)(const std::string&),
                 const char* (*show)(E), const std::string& choices, const std::string& doc) {
     auto get = accessor(access);
-    Field<T> f = base(key, "one of " + choices, "", doc);
+    Field<T> f = base(key, "text", choices, doc);
     f.read = [get, key, parse, show](Section& s, T& t) {
       std::string text = show(get(t));
       s.read(key, text);
@@ -189,7 +189,8 @@ class Table {
   }
 
   /// Registers --key flags on cmd (cli::CommandLine's option API) bound to target; the
-  /// target's current values are the defaults shown. Keys in skip get no flag.
+  /// target's current values are the defaults shown. A bool gets --key (true) and --no-key
+  /// (false). Keys in skip get no flag.
   template <class CommandLineT>
   void add_flags(CommandLineT& cmd, T& target, const std::set<std::string>& skip = {}) const {
     for (const Field<T>& f : flat()) {
@@ -199,6 +200,9 @@ class Table {
         cmd.custom_flag(
             flag_name(f.key), [&target, f] { f.parse("true", target); },
             help + " (default: " + f.show(target) + ")");
+        cmd.custom_flag(
+            "no-" + flag_name(f.key), [&target, f] { f.parse("false", target); },
+            "sets " + f.key + " false");
         continue;
       }
       cmd.custom_option(
