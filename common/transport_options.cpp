@@ -80,8 +80,7 @@ config::Table<TransportConfig> make_transport_table() {
   t.field(
       "dds_domain", [](C& c) -> int& { return c.dds.domain_id; }, "0..232", "DDS domain id");
   t.text_field(
-      "dds_peers", [](C& c) -> std::vector<std::string>& { return c.dds.peers; },
-      parse_peer_list,
+      "dds_peers", [](C& c) -> std::vector<std::string>& { return c.dds.peers; }, parse_peer_list,
       [](const std::vector<std::string>& peers) {
         std::string text;
         for (const std::string& p : peers) text += (text.empty() ? "" : ",") + p;

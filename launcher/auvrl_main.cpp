@@ -20,6 +20,7 @@
 #include "launcher/launcher.hpp"
 #include "launcher/run_config.hpp"
 #include "learner/learner_node.hpp"
+#include "sim/vehicle_model.hpp"
 #include "tools/arrival_search.hpp"
 
 namespace {
@@ -175,8 +176,8 @@ constexpr const char* kConfigDocPreamble =
     "this file is stale. Each section is a top-level map of a run configuration\n"
     "(config/presets/*.yaml); unknown keys are errors. The keys of `learner:` are also\n"
     "auv_learner's flags, those of `task:` and `actor:` auv_actor's (`replay_capacity` is\n"
-    "`--replay-capacity`, `scales.depth_m` is `--scales-depth-m`; a bool is a flag that sets it\n"
-    "true).\n";
+    "`--replay-capacity`, `scales.depth_m` is `--scales-depth-m`; a bool `key` has `--key`\n"
+    "and `--no-key`). The last two sections are blocks of a vehicle file (config/vehicles/).\n";
 
 /// `auvrl config-doc`: prints docs/configuration.md.
 int run_config_doc(int argc, const char* const* argv) {
@@ -192,7 +193,9 @@ int run_config_doc(int argc, const char* const* argv) {
       config::section_doc(auvrl::agent::actor_table()),
       config::section_doc(auvrl::launcher::run_table()),
       config::section_doc(auvrl::launcher::finetune_table()),
-      config::section_doc(auvrl::transport::transport_table())};
+      config::section_doc(auvrl::transport::transport_table()),
+      config::section_doc(auvrl::sim::thruster_dynamics_table()),
+      config::section_doc(auvrl::sim::blow_up_limits_table())};
   std::cout << config::render_markdown(sections, kConfigDocPreamble);
   return 0;
 }

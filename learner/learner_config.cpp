@@ -34,8 +34,7 @@ config::Table<DdpgConfig> make_ddpg_table() {
   t.field("gamma", &C::gamma, "", "discount");
   t.field("tau", &C::tau, "", "soft target update rate (Eq. 7)");
   t.field("batch_size", &C::batch_size, "transitions", "minibatch size m").range(1);
-  t.field("replay_capacity", &C::replay_capacity, "transitions", "replay buffer capacity")
-      .range(1);
+  t.field("replay_capacity", &C::replay_capacity, "transitions", "replay buffer capacity").range(1);
   t.field("td3_target_noise", &C::td3_target_noise, "", "TD3: std of the target policy noise");
   t.field("td3_target_noise_clip", &C::td3_target_noise_clip, "",
           "TD3: the target noise is clipped to +- this");

@@ -26,12 +26,12 @@ namespace auvrl::config {
 template <class V>
 struct Codec;
 
-#define AUVRL_CONFIG_CODEC(V, NAME)           \
-  template <>                                 \
-  struct Codec<V> {                           \
+#define AUVRL_CONFIG_CODEC(V, NAME)            \
+  template <>                                  \
+  struct Codec<V> {                            \
     static const char* type() { return NAME; } \
-    static std::string show(const V& value);  \
-    static V parse(const std::string& text);  \
+    static std::string show(const V& value);   \
+    static V parse(const std::string& text);   \
   }
 AUVRL_CONFIG_CODEC(double, "number");
 AUVRL_CONFIG_CODEC(float, "number");
@@ -63,7 +63,8 @@ std::string flag_name(const std::string& key);
 template <class T>
 struct Field {
   std::string key, type, unit, doc;
-  bool is_bool = false;  ///< a --flag without a value (sets true)
+  bool is_bool = false;   ///< a --flag without a value (sets true)
+  bool required = false;  ///< absent is an error
   std::function<void(Section&, T&)> read;
   std::function<void(const std::string&, T&)> parse;
   std::function<std::string(T&)> show;
@@ -139,6 +140,12 @@ class Table {
     return *this;
   }
 
+  /// The last field must be present (vehicle files: no defaults).
+  Table& required() {
+    fields_.back().required = true;
+    return *this;
+  }
+
   /// The last field must lie in [lo, hi]; checked on reading a file and on a flag.
   Table& range(double lo, double hi = std::numeric_limits<double>::infinity()) {
     Field<T>& f = fields_.back();
@@ -174,6 +181,7 @@ class Table {
   /// unreported: for a section shared with other readers).
   void read_keys(Section& section, T& target) const {
     for (const Field<T>& f : fields_) {
+      if (f.required && !section.has(f.key)) section.fail(f.key, "missing");
       f.read(section, target);
       if (f.check && section.has(f.key)) {
         const std::string error = f.check(target);
@@ -222,7 +230,8 @@ class Table {
   std::vector<FieldDoc> docs() const {
     T defaults{};
     std::vector<FieldDoc> rows;
-    for (const Field<T>& f : flat()) rows.push_back({f.key, f.type, f.show(defaults), f.unit, f.doc});
+    for (const Field<T>& f : flat())
+      rows.push_back({f.key, f.type, f.show(defaults), f.unit, f.doc});
     return rows;
   }
 
@@ -234,7 +243,7 @@ class Table {
   template <class Access>
   static auto accessor(Access access) {
     if constexpr (std::is_member_object_pointer_v<Access>) {
-      return [access](T& t) -> auto& { return t.*access; };
+      return [access](T & t) -> auto& { return t.*access; };
     } else {
       return access;
     }

@@ -59,7 +59,8 @@ class GoalSchedule {
 /// checks it and builds the schedule.
 struct GoalScheduleConfig {
   ScheduleInterpolation interpolation = ScheduleInterpolation::kLogLinear;
-  std::vector<std::vector<double>> knots{{0, 1.5}, {3000, 0.5}, {5000, 1e-4}};  ///< [episode, beta_m]
+  std::vector<std::vector<double>> knots{
+      {0, 1.5}, {3000, 0.5}, {5000, 1e-4}};  ///< [episode, beta_m]
 };
 
 /// The keys of a `schedule:` section (common/task/task_yaml.cpp).

@@ -140,10 +140,10 @@ TEST(ConfigTable, FlagsUseTheKeyNames) {
   cli::CommandLine cmd("prog", "test");
   const auto table = make_table();
   table.add_flags(cmd, s);
-  ASSERT_TRUE(parse(cmd, {"--batch-size", "16", "--replay-capacity", "99", "--verbose",
-                          "--no-filter", "--hidden", "32-16", "--start", "0,0,7", "--mode",
-                          "slow", "--timeout-ms", "20", "--inner-depth-m", "3", "--knots",
-                          "[[0, 2], [5, 1]]"}));
+  ASSERT_TRUE(
+      parse(cmd, {"--batch-size", "16", "--replay-capacity", "99", "--verbose", "--no-filter",
+                  "--hidden", "32-16", "--start", "0,0,7", "--mode", "slow", "--timeout-ms", "20",
+                  "--inner-depth-m", "3", "--knots", "[[0, 2], [5, 1]]"}));
   EXPECT_EQ(s.batch_size, 16);
   EXPECT_EQ(s.replay_capacity, 99u);
   EXPECT_TRUE(s.verbose);
