@@ -61,8 +61,11 @@ config::Table<Settings> make_table() {
 }
 
 config::Section load(const std::string& text) {
+  // One file per test: CTest runs the tests of this executable in parallel processes.
+  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string path =
-      (std::filesystem::temp_directory_path() / "auvrl_test_config_table.yaml").string();
+      (std::filesystem::temp_directory_path() / ("auvrl_test_config_table_" + name + ".yaml"))
+          .string();
   std::ofstream(path) << text;
   return config::load_file(path);
 }
@@ -121,7 +124,7 @@ TEST(ConfigTable, UnknownKeyNamesDottedKeyAndLine) {
 
 TEST(ConfigTable, WrongTypeNamesFileKeyAndLine) {
   const std::string e = read_error("test:\n  name: a\n  batch_size: many\n");
-  EXPECT_NE(e.find("auvrl_test_config_table.yaml"), std::string::npos) << e;
+  EXPECT_NE(e.find("auvrl_test_config_table_WrongType"), std::string::npos) << e;
   EXPECT_NE(e.find("'test.batch_size': expected an integer"), std::string::npos) << e;
   EXPECT_NE(e.find("(line 3)"), std::string::npos) << e;
   EXPECT_NE(read_error("test:\n  mode: medium\n").find("'test.mode': expected fast or slow"),
