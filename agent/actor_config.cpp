@@ -1,8 +1,61 @@
 #include "agent/actor_config.hpp"
 
+#include "common/config/table.hpp"
 #include "common/task/task_yaml.hpp"
 
 namespace auvrl::agent {
+namespace {
+
+const char* noise_name(ExplorationNoise::Kind kind) {
+  switch (kind) {
+    case ExplorationNoise::Kind::kNone:
+      return "none";
+    case ExplorationNoise::Kind::kGaussian:
+      return "gaussian";
+    default:
+      return "ou";
+  }
+}
+
+config::Table<ActorNodeConfig> make_actor_table() {
+  using C = ActorNodeConfig;
+  config::Table<C> t("actor", "auv_actor: exploration noise, messages, flow control, lockstep");
+  t.choice("noise", &C::noise, parse_noise_kind, noise_name, "ou, gaussian, none",
+           "exploration noise");
+  t.field("noise_sigma", &C::noise_sigma, "action units", "noise standard deviation");
+  t.field("noise_theta", &C::noise_theta, "per step", "OU mean reversion");
+  t.field("max_transitions_per_message", &C::max_transitions_per_message, "transitions",
+          "keeps an experience message near one datagram");
+  t.field("weights_request_period_s", &C::weights_request_period_s, "s",
+          "while it has no policy, ask for weights this often");
+  t.field("weights_silence_s", &C::weights_silence_s, "s",
+          "with a policy: ask again after this long unheard");
+  t.field("max_episodes", &C::max_episodes, "episodes, 0: until stopped", "stop after this many");
+  t.field("max_learner_backlog", &C::max_learner_backlog, "updates, 0: never wait",
+          "before an episode, wait while the learner owes more updates than this...");
+  t.field("max_wait_s", &C::max_wait_s, "s", "...but never longer than this");
+  t.field(
+       "lockstep_timeout_ms", [](C& c) -> int& { return c.lockstep.timeout_ms; }, "ms",
+       "a lockstep step unanswered this long is sent again")
+      .range(1);
+  t.field(
+       "lockstep_attempts", [](C& c) -> int& { return c.lockstep.attempts; }, "",
+       "attempts per step before the episode ends (END_SIM_TIMEOUT)")
+      .range(1);
+  t.field("demonstration_fraction", &C::demonstration_fraction, "",
+          "share of episodes driven by the PID baseline (experience only, not reported)")
+      .range(0, 1);
+  t.field("expert_labels", &C::expert_labels, "",
+          "label every transition with the PID baseline's command (the learner's imitation)");
+  return t;
+}
+
+}  // namespace
+
+const config::Table<ActorNodeConfig>& actor_table() {
+  static const config::Table<ActorNodeConfig> table = make_actor_table();
+  return table;
+}
 
 void read_actor_config_file(const std::string& path, ActorNodeConfig& c,
                             std::string* vehicle_path) {
@@ -16,34 +69,7 @@ void read_actor_config_file(const std::string& path, ActorNodeConfig& c,
   const task::GoalSchedule schedule =
       task::read_goal_schedule(root.child("schedule"), task::GoalSchedule());
   c.initial_beta_m = schedule.beta_m(0);
-  config::Section s = root.child("actor");
-  std::string noise = c.noise == ExplorationNoise::Kind::kNone       ? "none"
-                      : c.noise == ExplorationNoise::Kind::kGaussian ? "gaussian"
-                                                                     : "ou";
-  s.read("noise", noise);
-  try {
-    c.noise = parse_noise_kind(noise);
-  } catch (const std::invalid_argument& e) {
-    s.fail("noise", e.what());
-  }
-  s.read("noise_sigma", c.noise_sigma);
-  s.read("noise_theta", c.noise_theta);
-  s.read("max_transitions_per_message", c.max_transitions_per_message);
-  s.read("weights_request_period_s", c.weights_request_period_s);
-  s.read("weights_silence_s", c.weights_silence_s);
-  s.read("max_episodes", c.max_episodes);
-  s.read("max_learner_backlog", c.max_learner_backlog);
-  s.read("max_wait_s", c.max_wait_s);
-  s.read("lockstep_timeout_ms", c.lockstep.timeout_ms);
-  s.read("lockstep_attempts", c.lockstep.attempts);
-  s.read("demonstration_fraction", c.demonstration_fraction);
-  if (!(c.demonstration_fraction >= 0 && c.demonstration_fraction <= 1)) {
-    s.fail("demonstration_fraction", "must be in [0, 1]");
-  }
-  s.read("expert_labels", c.expert_labels);
-  if (c.lockstep.timeout_ms < 1) s.fail("lockstep_timeout_ms", "must be >= 1");
-  if (c.lockstep.attempts < 1) s.fail("lockstep_attempts", "must be >= 1");
-  s.finish();
+  actor_table().read(root.child("actor"), c);
   config::finish_run_file(root);
 }
 

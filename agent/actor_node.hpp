@@ -18,6 +18,11 @@
 #include "common/task/task.hpp"
 #include "common/transport.hpp"
 
+namespace auvrl::config {
+template <class T>
+class Table;
+}  // namespace auvrl::config
+
 namespace auvrl::agent {
 
 /// Everything auv_actor is configured with besides the transport.
@@ -56,6 +61,9 @@ struct ActorNodeConfig {
   bool expert_labels = false;
   std::shared_ptr<Controller> expert;  ///< required when expert_labels
 };
+
+/// The keys of an `actor:` section (agent/actor_config.cpp).
+const config::Table<ActorNodeConfig>& actor_table();
 
 /// Counters for logs and tests.
 struct ActorCounters {

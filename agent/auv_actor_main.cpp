@@ -9,6 +9,7 @@
 #include "agent/actor_node.hpp"
 #include "agent/pid_controller.hpp"
 #include "common/cli.hpp"
+#include "common/config/table.hpp"
 #include "common/signals.hpp"
 #include "common/transport_options.hpp"
 
@@ -26,53 +27,29 @@ int main(int argc, char** argv) {
     }
   }
   transport::TransportConfig transport_config;
-  std::string layout = task::to_string(config.task.layout),
-              reward = task::to_string(config.task.reward),
-              noise = config.noise == agent::ExplorationNoise::Kind::kNone       ? "none"
-                      : config.noise == agent::ExplorationNoise::Kind::kGaussian ? "gaussian"
-                                                                                 : "ou";
   int vehicle_id = -1, pin_cpu = -1, report_every = 50;
   std::int64_t seed = 1;
-  double start_z = config.task.start_position_ned_m.z();
 
   cli::CommandLine cmd("auv_actor",
                        "Exploration actor: runs episodes of the goal-driven task on its vehicle "
-                       "of auv_sim with the newest policy plus noise; sends experience.");
+                       "of auv_sim with the newest policy plus noise; sends experience. Every key "
+                       "of the task: and actor: sections is a flag (docs/configuration.md).");
   cmd.option("config", &config_path,
              "run configuration (YAML: task, schedule, actor); the options below override it");
   cmd.option("actor-id", &config.actor_id, "this actor's id (0..)");
   cmd.option("vehicle-id", &vehicle_id, "its vehicle in auv_sim (default: the actor id)");
-  cmd.option("layout", &layout, "state layout: paper, extended or extended_thrust");
-  cmd.option("reward", &reward, "reward: paper (Eq. 14) or shaped");
-  cmd.option("failure-reward", &config.task.failure_reward,
-             "reward on leaving beta_max or flipping (paper -10; -1/(1-gamma) fixes it)");
-  cmd.option("thrust-weight", &config.task.thrust_weight, "weight of the thrust cost f(Tr)");
-  cmd.option("beta-max", &config.task.beta_max_m, "safety radius around the goal, m");
-  cmd.flag("hold", &config.task.hold_mode, "reaching does not end the episode (learn to hold)");
-  cmd.option("max-steps", &config.task.max_steps, "episode length limit (700 = 70 s)");
-  cmd.option("start-depth", &start_z, "start depth, m (start is [0, 0, depth])");
-  cmd.option("noise", &noise, "exploration noise: ou, gaussian or none");
-  cmd.option("noise-sigma", &config.noise_sigma, "noise standard deviation");
-  cmd.option("noise-theta", &config.noise_theta, "OU mean reversion per step");
+  task::task_table().add_flags(cmd, config.task);
+  agent::actor_table().add_flags(cmd, config);
   cmd.option("initial-beta", &config.initial_beta_m, "goal radius until the learner's first");
   cmd.option("seed", &seed, "seed of way-points and noise (give each actor its own)");
-  cmd.option("max-episodes", &config.max_episodes, "stop after this many (0: until stopped)");
   cmd.option("pin-cpu", &pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &report_every, "a log line every N episodes");
-  cmd.option("demonstration-fraction", &config.demonstration_fraction,
-             "share of episodes driven by the PID baseline (experience only, not reported)");
-  cmd.flag("expert-labels", &config.expert_labels,
-           "label every transition with the PID baseline's command (the learner's imitation)");
   cmd.option("vehicle", &vehicle_path, "vehicle file of the PID demonstrator/expert (YAML)");
   transport::add_transport_options(cmd, transport_config);
   transport::LockstepBusOptions lockstep_bus;
   transport::add_lockstep_options(cmd, lockstep_bus);
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    config.task.layout = task::parse_layout(layout);
-    config.task.reward = task::parse_reward_kind(reward);
-    config.noise = agent::parse_noise_kind(noise);
-    config.task.start_position_ned_m.z() = start_z;
     config.vehicle_id = vehicle_id >= 0 ? vehicle_id : config.actor_id;
     config.seed = static_cast<std::uint64_t>(seed);
     config.task.validate();
@@ -110,8 +87,8 @@ int main(int argc, char** argv) {
     signals::install_stop_handlers();
     agent::ActorNode node(config, *transport, std::cerr, lockstep.get());
     std::cerr << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
-              << layout << " state (" << config.task.state_dim() << "), " << reward << " reward, "
-              << noise << " noise, seed " << seed << "\n";
+              << task::to_string(config.task.layout) << " state (" << config.task.state_dim()
+              << "), " << task::to_string(config.task.reward) << " reward, seed " << seed << "\n";
     double return_sum = 0.0;
     int successes = 0, window = 0;
     while (!signals::stop_requested() && !node.training_done() &&

@@ -65,15 +65,15 @@ void run_case(const transport::TransportConfig& config, int actors, double secon
                                            "td3",
                                            "--hidden",
                                            "64-64",
-                                           "--batch",
+                                           "--batch-size",
                                            "256",
                                            "--state-dim",
                                            "23",
                                            "--updates-per-transition",
                                            learner_ratio,
-                                           "--warmup",
+                                           "--warmup-transitions",
                                            "5000",
-                                           "--replay",
+                                           "--replay-capacity",
                                            "200000"};
   learner_argv.insert(learner_argv.end(), transport_args.begin(), transport_args.end());
   test_support::ChildProcess learner(learner_argv, dir + "/learner.log");

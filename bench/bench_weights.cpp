@@ -106,9 +106,9 @@ void run_case(const std::string& name, const transport::TransportConfig& config,
                                            std::to_string(kActionDim),
                                            "--hidden",
                                            hidden,
-                                           "--batch",
+                                           "--batch-size",
                                            "64",
-                                           "--replay",
+                                           "--replay-capacity",
                                            "100000"};
   for (const std::string& a : transport::transport_arguments(config)) learner_argv.push_back(a);
   test_support::ChildProcess learner(learner_argv, dir + "/learner.log");

@@ -1,6 +1,7 @@
 #include "common/transport_options.hpp"
 
 #include "common/cli.hpp"
+#include "common/config/table.hpp"
 #include "common/transport_dds.hpp"
 
 namespace auvrl::transport {
@@ -65,31 +66,49 @@ void apply_transport_arguments(const std::vector<std::string>& args, TransportCo
   cmd.parse(static_cast<int>(argv.size()), argv.data());
 }
 
+namespace {
+
+config::Table<TransportConfig> make_transport_table() {
+  using C = TransportConfig;
+  config::Table<C> t("transport",
+                     "the transport of every process (flags: --transport, --lcm-url, "
+                     "--dds-domain, --dds-peers, --dds-config, --allow-off-host)");
+  t.text_field(
+      "kind", &C::kind, parse_transport_kind, [](TransportKind k) { return to_string(k); },
+      "one of lcm, dds", "", "LCM (UDP multicast) or Cyclone DDS (unicast discovery)");
+  t.field("lcm_url", &C::lcm_url, "", "LCM URL of the system's bus");
+  t.field(
+      "dds_domain", [](C& c) -> int& { return c.dds.domain_id; }, "0..232", "DDS domain id");
+  t.text_field(
+      "dds_peers", [](C& c) -> std::vector<std::string>& { return c.dds.peers; }, parse_peer_list,
+      [](const std::vector<std::string>& peers) {
+        std::string text;
+        for (const std::string& p : peers) text += (text.empty() ? "" : ",") + p;
+        return text;
+      },
+      "string", "host[,host...]",
+      "hosts of the other DDS participants (anything but loopback needs allow_off_host)");
+  t.field(
+      "dds_config", [](C& c) -> std::string& { return c.dds.config_path; },
+      "path, relative to the configuration file",
+      "a Cyclone XML file replacing the generated configuration (needs allow_off_host)");
+  t.field("allow_off_host", &C::allow_off_host, "",
+          "accept a transport whose traffic can leave this host (no authentication!)");
+  return t;
+}
+
+}  // namespace
+
+const config::Table<TransportConfig>& transport_table() {
+  static const config::Table<TransportConfig> table = make_transport_table();
+  return table;
+}
+
 void read_transport_section(config::Section s, TransportConfig& config) {
-  std::string kind = to_string(config.kind);
-  s.read("kind", kind);
-  try {
-    config.kind = parse_transport_kind(kind);
-  } catch (const TransportError& e) {
-    s.fail("kind", e.what());
-  }
-  s.read("lcm_url", config.lcm_url);
-  s.read("dds_domain", config.dds.domain_id);
-  if (s.has("dds_peers")) {
-    std::string peers;
-    s.read("dds_peers", peers);
-    try {
-      config.dds.peers = parse_peer_list(peers);
-    } catch (const TransportError& e) {
-      s.fail("dds_peers", e.what());
-    }
-  }
+  transport_table().read_keys(s, config);
   if (s.has("dds_config")) {
-    std::string path;
-    s.read("dds_config", path);
-    config.dds.config_path = config::resolve_path(s, path);
+    config.dds.config_path = config::resolve_path(s, config.dds.config_path);
   }
-  s.read("allow_off_host", config.allow_off_host);
   s.finish();
   // Name the key that widens the configuration: the URL for LCM, the DDS settings otherwise.
   try {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/config/table.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/transport.hpp"
 
@@ -127,5 +128,8 @@ void apply_transport_arguments(const std::vector<std::string>& args, TransportCo
 ///     dds_config: cyclone.xml  # a Cyclone XML file (relative to the configuration file)
 ///     allow_off_host: false
 void read_transport_section(config::Section section, TransportConfig& config);
+
+/// The keys of a `transport:` section (documentation and reading).
+const config::Table<TransportConfig>& transport_table();
 
 }  // namespace auvrl::transport

@@ -2,10 +2,81 @@
 
 #include <stdexcept>
 
+#include "common/config/table.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/task/task_yaml.hpp"
 
 namespace auvrl::launcher {
+
+namespace {
+
+config::Table<RunSettings> make_run_table() {
+  using C = RunSettings;
+  config::Table<C> t("run", "the launcher (auvrl train): processes, budget, supervision");
+  t.field("actors", &C::actors, "0: one per CPU", "exploration actors").range(0);
+  t.field("seed", &C::seed, "", "actor i uses seed * 1000 + i (+ a restart offset)");
+  t.field("max_train_s", &C::max_train_s, "s, 0: until the learner ends",
+          "wall-clock training budget");
+  t.field("best_eval_period_s", &C::best_eval_period_s, "s",
+          "quick evaluation of the newest weights this often");
+  t.field("best_eval_suite", &C::best_eval_suite, "way-points",
+          "validation way-points in that quick evaluation");
+  t.field("best_eval_max_hold_m", &C::best_eval_max_hold_m, "m, > 0",
+          "the best policy holds within this on average");
+  t.field("learner_cpu", &C::learner_cpu, "-1: not pinned", "CPU the learner is pinned to");
+  t.field("private_lockstep_bus", &C::private_lockstep_bus, "",
+          "each simulator and its actor talk on a bus of their own");
+  t.field("max_restarts", &C::max_restarts, "",
+          "a role restarted more often than this within restart_window_s stops the run");
+  t.field("restart_window_s", &C::restart_window_s, "s", "see max_restarts");
+  t.field("heartbeat_timeout_s", &C::heartbeat_timeout_s, "s, 0: not watched",
+          "a process silent this long is taken as hung and restarted");
+  return t;
+}
+
+/// The objective of the fine-tuning's episodes.
+void add_objective_fields(config::Table<tuning::FinetuneConfig>& t) {
+  using C = tuning::FinetuneConfig;
+  t.field("hold_weight", &C::hold_weight, "s per m",
+          "weight of the mean distance over the arrival and hold_steps after it");
+  t.field("hold_steps", &C::hold_steps, "steps", "steps of holding the objective prices");
+  t.field("flip_margin_rad", &C::flip_margin_rad, "rad",
+          "|roll| or |pitch| beyond this costs flip_margin_weight");
+  t.field("flip_margin_weight", &C::flip_margin_weight, "s per rad", "see flip_margin_rad");
+  t.field("episode_steps", &C::episode_steps, "steps", "each episode's length");
+  t.field("pid_lag_weight", &C::pid_lag_weight, "s per s",
+          "cost of arriving later than pid_lead_s before the PID baseline");
+  t.field("pid_lead_s", &C::pid_lead_s, "s", "see pid_lag_weight");
+  t.field("integration_substeps", &C::integration_substeps, "0: the vehicle file's",
+          "integrator steps per control step in the objective's episodes");
+}
+
+config::Table<tuning::FinetuneConfig> make_finetune_table() {
+  using C = tuning::FinetuneConfig;
+  config::Table<C> t("finetune", "fine-tuning of the trained policy (evolution strategies)");
+  t.field("iterations", &C::iterations, "0: no fine-tuning", "fine-tuning iterations");
+  t.field("pairs", &C::pairs, "", "antithetic perturbation pairs per iteration");
+  t.field("sigma", &C::sigma, "weight units", "perturbation scale");
+  t.field("learning_rate", &C::learning_rate, "", "Adam's step on the rank-weighted direction");
+  t.field("episodes", &C::episodes, "way-points", "way-points the objective averages over");
+  t.field("random_heading_fraction", &C::random_heading_fraction, "0..1",
+          "of them, starting at a random heading");
+  add_objective_fields(t);
+  t.field("threads", &C::threads, "0: one per CPU", "policies evaluated at once");
+  return t;
+}
+
+}  // namespace
+
+const config::Table<RunSettings>& run_table() {
+  static const config::Table<RunSettings> table = make_run_table();
+  return table;
+}
+
+const config::Table<tuning::FinetuneConfig>& finetune_table() {
+  static const config::Table<tuning::FinetuneConfig> table = make_finetune_table();
+  return table;
+}
 
 RunConfig read_run_config(const std::string& path) {
   RunConfig c;
@@ -17,39 +88,14 @@ RunConfig read_run_config(const std::string& path) {
   config::Section learner = root.child("learner");
   learner.read("max_episodes", c.learner_max_episodes);
   config::Section run = root.child("run");
-  run.read("actors", c.run.actors);
-  run.read("seed", c.run.seed);
-  run.read("max_train_s", c.run.max_train_s);
-  run.read("best_eval_period_s", c.run.best_eval_period_s);
-  run.read("best_eval_suite", c.run.best_eval_suite);
-  run.read("best_eval_max_hold_m", c.run.best_eval_max_hold_m);
+  run_table().read_keys(run, c.run);
   if (!(c.run.best_eval_max_hold_m > 0.0)) {
     run.fail("best_eval_max_hold_m", "expected a hold error in metres greater than 0");
   }
-  run.read("learner_cpu", c.run.learner_cpu);
-  run.read("private_lockstep_bus", c.run.private_lockstep_bus);
-  run.read("max_restarts", c.run.max_restarts);
-  run.read("restart_window_s", c.run.restart_window_s);
-  run.read("heartbeat_timeout_s", c.run.heartbeat_timeout_s);
   run.finish();
   transport::read_transport_section(root.child("transport"), c.transport);
   config::Section finetune = root.child("finetune");
-  finetune.read("iterations", c.finetune.iterations);
-  finetune.read("pairs", c.finetune.pairs);
-  finetune.read("sigma", c.finetune.sigma);
-  finetune.read("learning_rate", c.finetune.learning_rate);
-  finetune.read("episodes", c.finetune.episodes);
-  finetune.read("random_heading_fraction", c.finetune.random_heading_fraction);
-  finetune.read("hold_weight", c.finetune.hold_weight);
-  finetune.read("hold_steps", c.finetune.hold_steps);
-  finetune.read("flip_margin_rad", c.finetune.flip_margin_rad);
-  finetune.read("flip_margin_weight", c.finetune.flip_margin_weight);
-  finetune.read("episode_steps", c.finetune.episode_steps);
-  finetune.read("pid_lag_weight", c.finetune.pid_lag_weight);
-  finetune.read("pid_lead_s", c.finetune.pid_lead_s);
-  finetune.read("integration_substeps", c.finetune.integration_substeps);
-  finetune.read("threads", c.finetune.threads);
-  finetune.finish();
+  finetune_table().read(finetune, c.finetune);
   try {
     c.finetune.validate();
   } catch (const std::invalid_argument& e) {

@@ -4,7 +4,9 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "common/config/table.hpp"
 #include "common/task/task.hpp"
 #include "common/transport_options.hpp"
 #include "tuning/policy_finetune.hpp"
@@ -47,5 +49,10 @@ struct RunConfig {
 
 /// Reads and checks a run configuration; throws config::ConfigError naming file, key and line.
 RunConfig read_run_config(const std::string& path);
+
+/// The keys of a `run:` section.
+const config::Table<RunSettings>& run_table();
+/// The keys of a `finetune:` section (tuning::FinetuneConfig).
+const config::Table<tuning::FinetuneConfig>& finetune_table();
 
 }  // namespace auvrl::launcher

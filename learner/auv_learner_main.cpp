@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "common/cli.hpp"
+#include "common/config/table.hpp"
 #include "common/nn/mlp.hpp"
 #include "common/signals.hpp"
 #include "common/transport_options.hpp"
@@ -52,52 +53,22 @@ int main(int argc, char** argv) {
     }
   }
   transport::TransportConfig transport_config;
-  std::string algo = learner::to_string(config.ddpg.algo), hidden, actor_hidden, critic_hidden;
-  std::int64_t seed = static_cast<std::int64_t>(config.ddpg.seed),
-               replay = static_cast<std::int64_t>(config.ddpg.replay_capacity);
+  std::string hidden;
   int threads = 1;
   bool bench = false, resume = false, keep_running = false;
   double bench_seconds = 2.0;
-  int bench_batch = 0;
 
   cli::CommandLine cmd("auv_learner",
                        "Central learner: replay buffer and networks, DDPG/TD3 updates from the "
-                       "actors' experience, weights broadcast, schedule, checkpoints.");
+                       "actors' experience, weights broadcast, schedule, checkpoints. Every key "
+                       "of the learner: section is a flag (docs/configuration.md).");
   cmd.option("config", &config_path,
              "run configuration (YAML: task, schedule, learner); the options below override it");
-  cmd.option("algo", &algo, "ddpg or td3");
-  cmd.flag("her", &config.her, "hindsight relabelling (future strategy) with the task's reward");
-  cmd.option("her-k", &config.her_k, "future goals per real one");
+  learner::learner_table().add_flags(cmd, config);
   cmd.option("state-dim", &config.ddpg.state_dim, "observation size (the task's layout)");
   cmd.option("action-dim", &config.ddpg.action_dim, "action size (thrusters)");
   cmd.option("hidden", &hidden, "hidden sizes of both networks, e.g. 400-300");
-  cmd.option("actor-hidden", &actor_hidden, "hidden sizes of the actor (default 400-300)");
-  cmd.option("critic-hidden", &critic_hidden, "hidden sizes of the critic (default 400-300)");
-  cmd.option("critic-action-layer", &config.ddpg.critic_action_layer,
-             "critic layer receiving the action (0 input, 1 after the first hidden)");
-  cmd.option("batch", &config.ddpg.batch_size, "minibatch size m");
-  double actor_lr = config.ddpg.actor_lr, critic_lr = config.ddpg.critic_lr,
-         critic_l2 = config.ddpg.critic_weight_decay, gamma = config.ddpg.gamma,
-         tau = config.ddpg.tau;
-  cmd.option("actor-lr", &actor_lr, "Adam learning rate of the actor");
-  cmd.option("critic-lr", &critic_lr, "Adam learning rate of the critic");
-  cmd.option("critic-l2", &critic_l2, "L2 weight decay of the critic");
-  cmd.option("gamma", &gamma, "discount");
-  cmd.option("tau", &tau, "soft target update rate");
-  cmd.option("replay", &replay, "replay buffer capacity (transitions)");
-  cmd.option("seed", &seed, "seed of the networks, sampling and TD3 noise");
-  cmd.option("updates-per-transition", &config.updates_per_transition,
-             "gradient updates per transition received (paper: 1)");
-  cmd.option("warmup", &config.warmup_transitions, "transitions before the first update");
-  cmd.option("broadcast-every", &config.broadcast_every_updates, "weights after every N updates");
-  cmd.option("broadcast-interval", &config.broadcast_min_interval_s,
-             "at most one weights broadcast per this many seconds");
-  cmd.option("max-actors", &config.max_actors, "actor ids accepted: 0..N-1");
-  cmd.option("max-episodes", &config.max_episodes, "end of training in episodes (0: never)");
-  cmd.option("max-updates", &config.max_updates, "end of training in updates (0: never)");
   cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
-  cmd.option("checkpoint-period", &config.checkpoint_period_s, "seconds between checkpoints");
-  cmd.option("keep-checkpoints", &config.keep_checkpoints, "checkpoints kept");
   cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
   cmd.flag("resume", &resume, "continue from the newest usable checkpoint in --checkpoint-dir");
   cmd.flag("keep-running", &keep_running, "keep serving after training is done");
@@ -105,25 +76,13 @@ int main(int argc, char** argv) {
   transport::add_transport_options(cmd, transport_config);
   cmd.flag("bench", &bench,
            "print updates/s for 64-64 batch 100, 256-256 batch 256, 400-300 batch 64 (or the one "
-           "case --hidden/--batch give) and exit");
+           "case --hidden/--batch-size give) and exit");
   cmd.option("bench-seconds", &bench_seconds, "measuring time per benchmark case");
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    config.ddpg.algo = learner::parse_algo(algo);
     if (!hidden.empty()) {
       config.ddpg.actor_hidden = config.ddpg.critic_hidden = learner::parse_hidden(hidden);
     }
-    if (!actor_hidden.empty()) config.ddpg.actor_hidden = learner::parse_hidden(actor_hidden);
-    if (!critic_hidden.empty()) config.ddpg.critic_hidden = learner::parse_hidden(critic_hidden);
-    config.ddpg.actor_lr = static_cast<float>(actor_lr);
-    config.ddpg.critic_lr = static_cast<float>(critic_lr);
-    config.ddpg.critic_weight_decay = static_cast<float>(critic_l2);
-    config.ddpg.gamma = static_cast<float>(gamma);
-    config.ddpg.tau = static_cast<float>(tau);
-    config.ddpg.seed = static_cast<std::uint64_t>(seed);
-    if (replay < 1) throw cli::UsageError("option --replay: must be >= 1");
-    config.ddpg.replay_capacity = static_cast<std::size_t>(replay);
-    bench_batch = config.ddpg.batch_size;
     if (resume && config.checkpoint_dir.empty()) {
       throw cli::UsageError("option --resume needs --checkpoint-dir");
     }
@@ -131,6 +90,7 @@ int main(int argc, char** argv) {
     std::cerr << "auv_learner: " << e.what() << "\n";
     return 2;
   }
+  const std::string algo = learner::to_string(config.ddpg.algo);
 
   try {
     nn::set_num_threads(threads);
@@ -138,9 +98,9 @@ int main(int argc, char** argv) {
       bool one_case = false;
       for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        one_case |= a.rfind("--hidden", 0) == 0 || a.rfind("--batch", 0) == 0;
+        one_case |= a.rfind("--hidden", 0) == 0 || a.rfind("--batch-size", 0) == 0;
       }
-      return run_bench(algo, hidden, bench_batch, threads, one_case, bench_seconds);
+      return run_bench(algo, hidden, config.ddpg.batch_size, threads, one_case, bench_seconds);
     }
     auto transport = transport::make_transport(transport_config);
     signals::install_stop_handlers();

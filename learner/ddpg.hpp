@@ -13,6 +13,11 @@
 #include "common/nn/random.hpp"
 #include "learner/replay_buffer.hpp"
 
+namespace auvrl::config {
+template <class T>
+class Table;
+}  // namespace auvrl::config
+
 namespace auvrl::learner {
 
 /// Which update rule.
@@ -81,6 +86,9 @@ struct DdpgConfig {
   /// Throws std::invalid_argument naming the first unusable value.
   void validate() const;
 };
+
+/// The keys of DdpgConfig in a `learner:` section (learner/learner_config.cpp).
+const config::Table<DdpgConfig>& ddpg_table();
 
 /// What one update reports.
 struct UpdateStats {

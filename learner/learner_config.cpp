@@ -1,59 +1,100 @@
 #include "learner/learner_config.hpp"
 
+#include <fmt/format.h>
+
+#include "common/config/table.hpp"
 #include "common/task/task_yaml.hpp"
 
 namespace auvrl::learner {
+namespace {
+
+/// Networks and optimisers.
+void add_network_fields(config::Table<DdpgConfig>& t) {
+  using C = DdpgConfig;
+  t.choice("algo", &C::algo, parse_algo, to_string, "ddpg, td3", "the algorithm");
+  t.field("actor_hidden", &C::actor_hidden, "units", "hidden sizes of the actor mu");
+  t.field("critic_hidden", &C::critic_hidden, "units", "hidden sizes of the critic Q");
+  t.field("critic_action_layer", &C::critic_action_layer, "0 or 1",
+          "critic layer receiving the action (0 with the state, 1 after the first hidden)");
+  t.field("actor_lr", &C::actor_lr, "", "Adam learning rate of the actor");
+  t.field("critic_lr", &C::critic_lr, "", "Adam learning rate of the critic");
+  t.field("critic_weight_decay", &C::critic_weight_decay, "",
+          "L2 weight decay of the critic's weights (not biases)");
+  t.field("actor_weight_decay", &C::actor_weight_decay, "", "L2 weight decay of the actor");
+  t.field("actor_grad_clip_norm", &C::actor_grad_clip_norm, "0: off",
+          "global-norm clipping of the actor's gradient");
+  t.field("critic_grad_clip_norm", &C::critic_grad_clip_norm, "0: off",
+          "global-norm clipping of the critic's gradient");
+}
+
+config::Table<DdpgConfig> make_ddpg_table() {
+  using C = DdpgConfig;
+  config::Table<C> t("learner", "the algorithm's settings");
+  add_network_fields(t);
+  t.field("gamma", &C::gamma, "", "discount");
+  t.field("tau", &C::tau, "", "soft target update rate (Eq. 7)");
+  t.field("batch_size", &C::batch_size, "transitions", "minibatch size m").range(1);
+  t.field("replay_capacity", &C::replay_capacity, "transitions", "replay buffer capacity").range(1);
+  t.field("td3_target_noise", &C::td3_target_noise, "", "TD3: std of the target policy noise");
+  t.field("td3_target_noise_clip", &C::td3_target_noise_clip, "",
+          "TD3: the target noise is clipped to +- this");
+  t.field("td3_policy_delay", &C::td3_policy_delay, "updates",
+          "TD3: critic updates per actor and target update");
+  t.field("expert_weight", &C::expert_weight, "0: off",
+          "weight of the Q-filtered imitation of the actors' expert labels");
+  t.field("expert_q_filter", &C::expert_q_filter, "",
+          "imitate only where the critic prefers the expert's action");
+  t.field("expert_weight_half_life_updates", &C::expert_weight_half_life_updates,
+          "updates, 0: constant", "the expert weight halves every this many updates");
+  t.field("seed", &C::seed, "", "seed of the networks, sampling and TD3 noise");
+  return t;
+}
+
+config::Table<LearnerNodeConfig> make_learner_table() {
+  using C = LearnerNodeConfig;
+  config::Table<C> t("learner", "auv_learner: algorithm, replay, updates, broadcasts, checkpoints");
+  t.include(ddpg_table(), &C::ddpg);
+  t.field("updates_per_transition", &C::updates_per_transition, "",
+          "gradient updates per transition received (paper: 1)");
+  t.field("warmup_transitions", &C::warmup_transitions, "transitions",
+          "updates start once the buffer holds more than max(batch_size, this)");
+  t.field("max_update_backlog", &C::max_update_backlog, "updates",
+          "most updates owed at once (the surplus is skipped)");
+  t.field("max_updates_per_poll", &C::max_updates_per_poll, "updates",
+          "most updates between two looks at the network");
+  t.field("broadcast_every_updates", &C::broadcast_every_updates, "updates",
+          "weights go out after every this many updates...");
+  t.field("broadcast_min_interval_s", &C::broadcast_min_interval_s, "s, 0: no limit",
+          "...but at most once per this interval");
+  t.field("max_actors", &C::max_actors, "", "actor ids accepted: 0 .. max_actors - 1");
+  t.field("stats_period_s", &C::stats_period_s, "s", "period of LEARNER_STATS");
+  t.field("max_episodes", &C::max_episodes, "episodes, 0: never", "end of training");
+  t.field("max_updates", &C::max_updates, "updates, 0: never", "end of training");
+  t.field("checkpoint_period_s", &C::checkpoint_period_s, "s", "time between checkpoints");
+  t.field("keep_checkpoints", &C::keep_checkpoints, "", "checkpoints kept");
+  t.field("her", &C::her, "", "hindsight relabelling (future strategy) with the task's reward");
+  t.field("her_k", &C::her_k, "", "HER: future goals per real one");
+  return t;
+}
+
+}  // namespace
+
+const config::Table<DdpgConfig>& ddpg_table() {
+  static const config::Table<DdpgConfig> table = make_ddpg_table();
+  return table;
+}
+
+const config::Table<LearnerNodeConfig>& learner_table() {
+  static const config::Table<LearnerNodeConfig> table = make_learner_table();
+  return table;
+}
 
 void read_learner_section(config::Section s, LearnerNodeConfig& c) {
-  std::string algo = to_string(c.ddpg.algo);
-  s.read("algo", algo);
+  learner_table().read(s, c);
   try {
-    c.ddpg.algo = parse_algo(algo);
+    c.ddpg.validate();
   } catch (const std::invalid_argument& e) {
-    s.fail("algo", e.what());
-  }
-  DdpgConfig& d = c.ddpg;
-  s.read("actor_hidden", d.actor_hidden);
-  s.read("critic_hidden", d.critic_hidden);
-  s.read("critic_action_layer", d.critic_action_layer);
-  s.read("actor_lr", d.actor_lr);
-  s.read("critic_lr", d.critic_lr);
-  s.read("critic_weight_decay", d.critic_weight_decay);
-  s.read("actor_weight_decay", d.actor_weight_decay);
-  s.read("actor_grad_clip_norm", d.actor_grad_clip_norm);
-  s.read("critic_grad_clip_norm", d.critic_grad_clip_norm);
-  s.read("gamma", d.gamma);
-  s.read("tau", d.tau);
-  s.read("batch_size", d.batch_size);
-  std::uint64_t capacity = d.replay_capacity;
-  s.read("replay_capacity", capacity);
-  d.replay_capacity = capacity;
-  s.read("td3_target_noise", d.td3_target_noise);
-  s.read("td3_target_noise_clip", d.td3_target_noise_clip);
-  s.read("td3_policy_delay", d.td3_policy_delay);
-  s.read("expert_weight", d.expert_weight);
-  s.read("expert_q_filter", d.expert_q_filter);
-  s.read("expert_weight_half_life_updates", d.expert_weight_half_life_updates);
-  s.read("seed", d.seed);
-  s.read("updates_per_transition", c.updates_per_transition);
-  s.read("warmup_transitions", c.warmup_transitions);
-  s.read("max_update_backlog", c.max_update_backlog);
-  s.read("max_updates_per_poll", c.max_updates_per_poll);
-  s.read("broadcast_every_updates", c.broadcast_every_updates);
-  s.read("broadcast_min_interval_s", c.broadcast_min_interval_s);
-  s.read("max_actors", c.max_actors);
-  s.read("stats_period_s", c.stats_period_s);
-  s.read("max_episodes", c.max_episodes);
-  s.read("max_updates", c.max_updates);
-  s.read("checkpoint_period_s", c.checkpoint_period_s);
-  s.read("keep_checkpoints", c.keep_checkpoints);
-  s.read("her", c.her);
-  s.read("her_k", c.her_k);
-  s.finish();
-  try {
-    d.validate();
-  } catch (const std::invalid_argument& e) {
-    throw config::ConfigError(s.file() + ": learner: " + e.what());
+    throw config::ConfigError(fmt::format("{}: learner: {}", s.file(), e.what()));
   }
 }
 

@@ -63,6 +63,9 @@ struct LearnerNodeConfig {
   std::string policy_path;  ///< where finish() writes the actor network (optional)
 };
 
+/// The keys of a `learner:` section: ddpg_table() and the node's own (learner_config.cpp).
+const config::Table<LearnerNodeConfig>& learner_table();
+
 /// Counters of what arrived and what was done with it.
 struct LearnerCounters {
   std::int64_t transitions_received = 0;

@@ -36,6 +36,8 @@
 #include <sstream>
 #include <utility>
 
+#include "common/config/table.hpp"
+
 namespace auvrl::sim {
 namespace {
 
@@ -189,6 +191,42 @@ class FileReader {
  private:
   std::string file_;
 };
+
+/// Reads a block through its table; errors keep VehicleFileError's field and line.
+template <class T>
+void read_block(const std::string& file, const YAML::Node& node, const std::string& key,
+                const config::Table<T>& table, T& target) {
+  try {
+    table.read(config::Section(file, key, node), target);
+  } catch (const config::ConfigError& e) {
+    throw VehicleFileError(file, e.key().empty() ? key : e.key(), e.detail());
+  }
+}
+
+config::Table<ThrusterDynamics> make_thruster_dynamics_table() {
+  using C = ThrusterDynamics;
+  config::Table<C> t("thruster_dynamics", "vehicle file: thruster response (all keys required)");
+  t.field("max_thrust_n", &C::max_thrust_n, "N", "symmetric saturation per thruster").required();
+  t.field("delay_enabled", &C::delay_enabled, "", "one control-step delay of the command")
+      .required();
+  t.field("lag_enabled", &C::lag_enabled, "", "first-order low-pass on the realised thrust")
+      .required();
+  t.field("lag_time_constant_s", &C::lag_time_constant_s, "s", "that low-pass's time constant")
+      .required();
+  t.field("slew_enabled", &C::slew_enabled, "", "rate limit on the realised thrust").required();
+  t.field("slew_rate_n_per_s", &C::slew_rate_n_per_s, "N/s", "that rate limit").required();
+  return t;
+}
+
+config::Table<BlowUpLimits> make_blow_up_limits_table() {
+  using C = BlowUpLimits;
+  config::Table<C> t("blow_up_limits",
+                     "vehicle file: beyond these the state is declared blown up (all required)");
+  t.field("max_linear_speed_mps", &C::max_linear_speed_mps, "m/s", "body speed").required();
+  t.field("max_angular_rate_rad_s", &C::max_angular_rate_rad_s, "rad/s", "body rate").required();
+  t.field("max_position_m", &C::max_position_m, "m", "distance from the origin").required();
+  return t;
+}
 
 // ---- Model-level validation (shared by files and models built in code). ---------------------
 
@@ -348,6 +386,16 @@ void finalize_vehicle_model(VehicleModel& model) {
   model.mass_total_inverse = llt.solve(Matrix6::Identity());
 }
 
+const config::Table<ThrusterDynamics>& thruster_dynamics_table() {
+  static const config::Table<ThrusterDynamics> table = make_thruster_dynamics_table();
+  return table;
+}
+
+const config::Table<BlowUpLimits>& blow_up_limits_table() {
+  static const config::Table<BlowUpLimits> table = make_blow_up_limits_table();
+  return table;
+}
+
 VehicleModel load_vehicle_file(const std::string& path) {
   const FileReader in(path);
   YAML::Node root;
@@ -427,18 +475,8 @@ VehicleModel load_vehicle_file(const std::string& path) {
     model.thrusters.push_back(thruster);
   }
 
-  const YAML::Node dyn = in.require(root, "", "thruster_dynamics");
-  const std::string dyn_field = "thruster_dynamics";
-  in.check_map(dyn, dyn_field,
-               {"max_thrust_n", "delay_enabled", "lag_enabled", "lag_time_constant_s",
-                "slew_enabled", "slew_rate_n_per_s"});
-  ThrusterDynamics& td = model.thruster_dynamics;
-  td.max_thrust_n = in.number(dyn, dyn_field, "max_thrust_n");
-  td.delay_enabled = in.boolean(dyn, dyn_field, "delay_enabled");
-  td.lag_enabled = in.boolean(dyn, dyn_field, "lag_enabled");
-  td.lag_time_constant_s = in.number(dyn, dyn_field, "lag_time_constant_s");
-  td.slew_enabled = in.boolean(dyn, dyn_field, "slew_enabled");
-  td.slew_rate_n_per_s = in.number(dyn, dyn_field, "slew_rate_n_per_s");
+  read_block(path, in.require(root, "", "thruster_dynamics"), "thruster_dynamics",
+             thruster_dynamics_table(), model.thruster_dynamics);
 
   const YAML::Node integration = in.require(root, "", "integration");
   in.check_map(integration, "integration", {"control_step_s", "integrator", "substeps"});
@@ -455,13 +493,8 @@ VehicleModel load_vehicle_file(const std::string& path) {
   }
   model.substeps = in.integer(integration, "integration", "substeps");
 
-  const YAML::Node limits = in.require(root, "", "blow_up_limits");
-  in.check_map(limits, "blow_up_limits",
-               {"max_linear_speed_mps", "max_angular_rate_rad_s", "max_position_m"});
-  model.blow_up.max_linear_speed_mps = in.number(limits, "blow_up_limits", "max_linear_speed_mps");
-  model.blow_up.max_angular_rate_rad_s =
-      in.number(limits, "blow_up_limits", "max_angular_rate_rad_s");
-  model.blow_up.max_position_m = in.number(limits, "blow_up_limits", "max_position_m");
+  read_block(path, in.require(root, "", "blow_up_limits"), "blow_up_limits", blow_up_limits_table(),
+             model.blow_up);
 
   finalize_vehicle_model(model);
   return model;

@@ -7,6 +7,11 @@
 #include <string>
 #include <vector>
 
+namespace auvrl::config {
+template <class T>
+class Table;
+}  // namespace auvrl::config
+
 namespace auvrl::sim {
 
 /// Most thrusters a vehicle file may declare; bounds the fixed-capacity thrust vectors so the
@@ -116,6 +121,10 @@ int allocation_rank(const AllocationMatrix& allocation);
 
 /// Loads and validates a vehicle file; throws VehicleFileError naming file and field.
 VehicleModel load_vehicle_file(const std::string& path);
+
+/// The keys of a vehicle file's thruster_dynamics: and blow_up_limits: blocks (all required).
+const config::Table<ThrusterDynamics>& thruster_dynamics_table();
+const config::Table<BlowUpLimits>& blow_up_limits_table();
 
 /// Fills the derived members (allocation, mass matrices) and validates the whole model;
 /// throws VehicleFileError with model.source_file. Called by load_vehicle_file; public so

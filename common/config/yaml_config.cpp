@@ -8,9 +8,11 @@ namespace auvrl::config {
 Section::Section(std::string file, std::string path, YAML::Node node)
     : file_(std::move(file)), path_(std::move(path)), node_(std::move(node)) {
   if (node_.IsDefined() && !node_.IsNull() && !node_.IsMap()) {
-    throw ConfigError(file_ + ": '" + (path_.empty() ? std::string("top level") : path_) +
-                      "' must be a map of keys (line " + std::to_string(node_.Mark().line + 1) +
-                      ")");
+    const std::string detail =
+        "must be a map of keys (line " + std::to_string(node_.Mark().line + 1) + ")";
+    throw ConfigError(
+        file_ + ": '" + (path_.empty() ? std::string("top level") : path_) + "' " + detail, path_,
+        detail);
   }
 }
 
@@ -23,7 +25,8 @@ void Section::fail(const std::string& key, const std::string& what) const {
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node();
   if (n.IsDefined() && n.Mark().line >= 0)
     where = " (line " + std::to_string(n.Mark().line + 1) + ")";
-  throw ConfigError(file_ + ": '" + key_path(key) + "': " + what + where);
+  throw ConfigError(file_ + ": '" + key_path(key) + "': " + what + where, key_path(key),
+                    what + where);
 }
 
 bool Section::has(const std::string& key) const {
@@ -181,9 +184,10 @@ void Section::finish() const {
     if (read_.count(key) == 0) {
       std::string known;
       for (const auto& k : read_) known += (known.empty() ? "" : ", ") + k;
-      throw ConfigError(file_ + ": '" + key_path(key) + "': unknown key (line " +
-                        std::to_string(entry.first.Mark().line + 1) + "; known here: " + known +
-                        ")");
+      const std::string detail = "unknown key (line " +
+                                 std::to_string(entry.first.Mark().line + 1) +
+                                 "; known here: " + known + ")";
+      throw ConfigError(file_ + ": '" + key_path(key) + "': " + detail, key_path(key), detail);
     }
   }
 }

@@ -20,6 +20,15 @@ namespace auvrl::config {
 class ConfigError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  /// key: the dotted key at fault; detail: what is wrong with it (without file and line).
+  ConfigError(const std::string& message, std::string key, std::string detail)
+      : std::runtime_error(message), key_(std::move(key)), detail_(std::move(detail)) {}
+  const std::string& key() const { return key_; }  ///< "" when the error names no key
+  const std::string& detail() const { return detail_; }
+
+ private:
+  std::string key_;
+  std::string detail_;
 };
 
 /// A map in a configuration file. read() fills a target only when the key is present; finish()
@@ -44,6 +53,7 @@ class Section {
   Section child(const std::string& key);
   /// Marks keys as known without reading them (sections other processes read).
   void ignore(std::initializer_list<const char*> keys);
+  void ignore_key(const std::string& key) { read_.insert(key); }
   /// Throws ConfigError for any key nobody read.
   void finish() const;
 

@@ -7,6 +7,11 @@
 #include <string>
 #include <vector>
 
+namespace auvrl::config {
+template <class T>
+class Table;
+}  // namespace auvrl::config
+
 namespace auvrl::task {
 
 /// How beta moves between two knots.
@@ -49,5 +54,16 @@ class GoalSchedule {
   std::vector<ScheduleKnot> knots_;
   ScheduleInterpolation interpolation_;
 };
+
+/// The `schedule:` section as written (the paper's schedule by default); to_goal_schedule()
+/// checks it and builds the schedule.
+struct GoalScheduleConfig {
+  ScheduleInterpolation interpolation = ScheduleInterpolation::kLogLinear;
+  std::vector<std::vector<double>> knots{
+      {0, 1.5}, {3000, 0.5}, {5000, 1e-4}};  ///< [episode, beta_m]
+};
+
+/// The keys of a `schedule:` section (common/task/task_yaml.cpp).
+const config::Table<GoalScheduleConfig>& goal_schedule_table();
 
 }  // namespace auvrl::task

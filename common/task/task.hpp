@@ -9,6 +9,11 @@
 #include <string>
 #include <vector>
 
+namespace auvrl::config {
+template <class T>
+class Table;
+}  // namespace auvrl::config
+
 namespace auvrl::task {
 
 /// Which observation vector the networks see.
@@ -112,6 +117,9 @@ struct TaskConfig {
   /// Throws std::invalid_argument naming the first unusable value.
   void validate() const;
 };
+
+/// The keys of a `task:` section (common/task/task_yaml.cpp).
+const config::Table<TaskConfig>& task_table();
 
 /// What the vehicle reports, as the task uses it.
 struct Observation {

@@ -1,82 +1,137 @@
 #include "common/task/task_yaml.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
+#include "common/config/table.hpp"
+
 namespace auvrl::task {
+namespace {
+
+config::Table<ObservationScales> make_scales_table() {
+  using S = ObservationScales;
+  config::Table<S> t("scales", "fixed scales that bring every input to roughly [-1, 1]");
+  t.field("position_m", &S::position_m, "m", "scale of positions and goal errors");
+  t.field("linear_velocity_mps", &S::linear_velocity_mps, "m/s", "scale of body velocities");
+  t.field("angular_rate_rad_s", &S::angular_rate_rad_s, "rad/s", "scale of body rates");
+  t.field("depth_m", &S::depth_m, "m", "scale of the depth input");
+  return t;
+}
+
+/// The reward's terms.
+void add_reward_fields(config::Table<TaskConfig>& t) {
+  using C = TaskConfig;
+  t.choice("reward", &C::reward, parse_reward_kind, to_string, "paper, shaped",
+           "reward: paper (Eq. 14) or shaped (dense progress term)");
+  t.field("goal_reward", &C::goal_reward, "", "reward on reaching the goal radius beta");
+  t.field("step_penalty", &C::step_penalty, "per step", "the -1 of Eq. 14");
+  t.field("thrust_weight", &C::thrust_weight, "", "weight of the thrust cost mean(u_i^2)");
+  t.field("failure_reward", &C::failure_reward, "",
+          "reward on leaving beta_max or flipping (paper -10; -1/(1-gamma) fixes it)");
+  t.field("progress_weight", &C::progress_weight, "per m",
+          "shaped reward: per metre of progress toward the goal");
+  t.field("beta_max_m", &C::beta_max_m, "m", "safety sphere around the goal");
+  t.field("flip_angle_rad", &C::flip_angle_rad, "rad",
+          "|roll| or |pitch| beyond this ends the episode");
+  t.field("hold_mode", &C::hold_mode, "",
+          "reaching does not end the episode; each step inside beta earns hold_reward_per_step");
+  t.field("hold_reward_per_step", &C::hold_reward_per_step, "per step", "hold mode's reward");
+  t.field("distance_weight", &C::distance_weight, "per m and step",
+          "shaped reward: -distance_weight * d");
+  t.field("precision_reward", &C::precision_reward, "per step",
+          "shaped reward: +precision_reward * exp(-d / precision_scale_m)");
+  t.field("precision_scale_m", &C::precision_scale_m, "m", "scale of the precision term");
+}
+
+/// Episode length, start and goal region.
+void add_episode_fields(config::Table<TaskConfig>& t) {
+  using C = TaskConfig;
+  t.field("max_steps", &C::max_steps, "steps", "episode length limit (700 = 70 s)");
+  t.field("control_step_s", &C::control_step_s, "s", "control step");
+  t.field("start_position_ned_m", &C::start_position_ned_m, "m, NED", "start position");
+  t.field("start_yaw_rad", &C::start_yaw_rad, "rad", "start heading");
+  t.field("goal_min_ned_m", &C::goal_min_ned_m, "m, NED",
+          "way-points are drawn uniformly in the box from here...");
+  t.field("goal_max_ned_m", &C::goal_max_ned_m, "m, NED", "...to here");
+  t.field("random_start_fraction", &C::random_start_fraction, "0..1",
+          "share of training episodes started in a random state (exploring starts)");
+  t.field("start_attitude_spread_rad", &C::start_attitude_spread_rad, "rad",
+          "random starts: roll, pitch, yaw uniform in +- this");
+  t.field("start_velocity_max_body_mps", &C::start_velocity_max_body_mps, "m/s",
+          "random starts: u, v, w uniform in +- this");
+  t.field("start_rate_max_body_rad_s", &C::start_rate_max_body_rad_s, "rad/s",
+          "random starts: p, q, r uniform in +- this");
+}
+
+config::Table<TaskConfig> make_task_table() {
+  using C = TaskConfig;
+  config::Table<C> t("task", "the task every process shares: observation, reward, episodes");
+  t.choice("layout", &C::layout, parse_layout, to_string, "paper, extended, extended_thrust",
+           "state layout (observation vector)");
+  t.section("scales", make_scales_table(), &C::scales);
+  t.field("num_thrusters", &C::num_thrusters, "", "action size");
+  t.field("max_thrust_n", &C::max_thrust_n, "N", "action +-1 maps to +- this");
+  add_reward_fields(t);
+  add_episode_fields(t);
+  return t;
+}
+
+config::Table<GoalScheduleConfig> make_schedule_table() {
+  using C = GoalScheduleConfig;
+  config::Table<C> t("schedule", "the goal radius beta as a function of finished episodes");
+  t.choice("interpolation", &C::interpolation, parse_interpolation, to_string,
+           "log_linear, linear, step", "how beta moves between two knots");
+  t.field("knots", &C::knots, "[episode, m]",
+          "knots [[episode, beta_m], ...], episodes strictly increasing, beta > 0");
+  return t;
+}
+
+}  // namespace
+
+const config::Table<TaskConfig>& task_table() {
+  static const config::Table<TaskConfig> table = make_task_table();
+  return table;
+}
+
+const config::Table<GoalScheduleConfig>& goal_schedule_table() {
+  static const config::Table<GoalScheduleConfig> table = make_schedule_table();
+  return table;
+}
 
 void read_task_config(config::Section s, TaskConfig& c) {
-  std::string layout = to_string(c.layout), reward = to_string(c.reward);
-  s.read("layout", layout);
-  s.read("reward", reward);
-  try {
-    c.layout = parse_layout(layout);
-  } catch (const std::invalid_argument& e) {
-    s.fail("layout", e.what());
-  }
-  try {
-    c.reward = parse_reward_kind(reward);
-  } catch (const std::invalid_argument& e) {
-    s.fail("reward", e.what());
-  }
-  config::Section scales = s.child("scales");
-  scales.read("position_m", c.scales.position_m);
-  scales.read("linear_velocity_mps", c.scales.linear_velocity_mps);
-  scales.read("angular_rate_rad_s", c.scales.angular_rate_rad_s);
-  scales.read("depth_m", c.scales.depth_m);
-  scales.finish();
-  s.read("num_thrusters", c.num_thrusters);
-  s.read("max_thrust_n", c.max_thrust_n);
-  s.read("goal_reward", c.goal_reward);
-  s.read("step_penalty", c.step_penalty);
-  s.read("thrust_weight", c.thrust_weight);
-  s.read("failure_reward", c.failure_reward);
-  s.read("progress_weight", c.progress_weight);
-  s.read("beta_max_m", c.beta_max_m);
-  s.read("flip_angle_rad", c.flip_angle_rad);
-  s.read("hold_mode", c.hold_mode);
-  s.read("hold_reward_per_step", c.hold_reward_per_step);
-  s.read("distance_weight", c.distance_weight);
-  s.read("precision_reward", c.precision_reward);
-  s.read("precision_scale_m", c.precision_scale_m);
-  s.read("max_steps", c.max_steps);
-  s.read("control_step_s", c.control_step_s);
-  s.read("start_position_ned_m", c.start_position_ned_m);
-  s.read("start_yaw_rad", c.start_yaw_rad);
-  s.read("goal_min_ned_m", c.goal_min_ned_m);
-  s.read("goal_max_ned_m", c.goal_max_ned_m);
-  s.read("random_start_fraction", c.random_start_fraction);
-  s.read("start_attitude_spread_rad", c.start_attitude_spread_rad);
-  s.read("start_velocity_max_body_mps", c.start_velocity_max_body_mps);
-  s.read("start_rate_max_body_rad_s", c.start_rate_max_body_rad_s);
-  s.finish();
+  task_table().read(s, c);
   try {
     c.validate();
   } catch (const std::invalid_argument& e) {
-    throw config::ConfigError(s.file() + ": " + e.what());
+    throw config::ConfigError(fmt::format("{}: {}", s.file(), e.what()));
   }
 }
 
-GoalSchedule read_goal_schedule(config::Section s, const GoalSchedule& fallback) {
-  std::string interpolation = to_string(fallback.interpolation());
-  std::vector<std::vector<double>> knots;
-  for (const ScheduleKnot& k : fallback.knots()) {
-    knots.push_back({static_cast<double>(k.episode), k.beta_m});
-  }
-  s.read("interpolation", interpolation);
-  s.read("knots", knots);
-  s.finish();
-  std::vector<ScheduleKnot> parsed;
-  for (const auto& row : knots) {
-    if (row.size() != 2) s.fail("knots", "each knot is [episode, beta_m]");
+GoalSchedule to_goal_schedule(const GoalScheduleConfig& c) {
+  std::vector<ScheduleKnot> knots;
+  for (const auto& row : c.knots) {
+    if (row.size() != 2) throw std::invalid_argument("each knot is [episode, beta_m]");
     // Checked before the conversion: a double beyond int64's range does not convert (found by
     // fuzz_run_config).
     if (!(row[0] >= 0 && row[0] <= 1e15 && row[0] == std::floor(row[0]))) {
-      s.fail("knots", "a knot's episode must be a whole number from 0 to 1e15");
+      throw std::invalid_argument("a knot's episode must be a whole number from 0 to 1e15");
     }
-    parsed.push_back({static_cast<std::int64_t>(row[0]), row[1]});
+    knots.push_back({static_cast<std::int64_t>(row[0]), row[1]});
   }
+  return GoalSchedule(knots, c.interpolation);
+}
+
+GoalSchedule read_goal_schedule(config::Section s, const GoalSchedule& fallback) {
+  GoalScheduleConfig c;
+  c.interpolation = fallback.interpolation();
+  c.knots.clear();
+  for (const ScheduleKnot& k : fallback.knots()) {
+    c.knots.push_back({static_cast<double>(k.episode), k.beta_m});
+  }
+  goal_schedule_table().read(s, c);
   try {
-    return GoalSchedule(parsed, parse_interpolation(interpolation));
+    return to_goal_schedule(c);
   } catch (const std::invalid_argument& e) {
     s.fail("knots", e.what());
   }

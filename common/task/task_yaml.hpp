@@ -1,4 +1,5 @@
-// The `task:` and `schedule:` sections of a run configuration (config/presets/*.yaml).
+// The `task:` and `schedule:` sections of a run configuration (config/presets/*.yaml), read
+// through their tables (task_table(), goal_schedule_table()).
 #pragma once
 
 #include "common/config/yaml_config.hpp"
@@ -14,5 +15,8 @@ void read_task_config(config::Section section, TaskConfig& config);
 /// A `schedule:` section: interpolation (log_linear | linear | step) and knots
 /// [[episode, beta_m], ...]; absent: `fallback`.
 GoalSchedule read_goal_schedule(config::Section section, const GoalSchedule& fallback);
+
+/// The schedule a `schedule:` section describes; throws std::invalid_argument when unusable.
+GoalSchedule to_goal_schedule(const GoalScheduleConfig& config);
 
 }  // namespace auvrl::task
