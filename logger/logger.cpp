@@ -1,5 +1,6 @@
 #include "logger/logger.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <iomanip>
 #include <iostream>
 #include <stdexcept>
 
@@ -214,20 +214,16 @@ void Logger::write_summary(std::ostream& out, const Schema* schema) const {
       << " write_errors " << write_errors_ << "\n\n";
   std::size_t width = 8;
   for (const ChannelCounts& c : channels_) width = std::max(width, c.channel.size());
-  out << std::left << std::setw(static_cast<int>(width)) << "channel" << std::right << std::setw(12)
-      << "received" << std::setw(12) << "written" << std::setw(12) << "throttled" << std::setw(8)
-      << "errors" << std::setw(14) << "bytes"
-      << "  type\n";
+  out << fmt::format("{:<{}}{:>12}{:>12}{:>12}{:>8}{:>14}  type\n", "channel", width, "received",
+                     "written", "throttled", "errors", "bytes");
   for (const ChannelCounts& c : channels_) {
     std::string types;
     for (const std::uint64_t fp : c.fingerprints) {
       if (!types.empty()) types += ", ";
       types += schema != nullptr ? schema->names_for(fp) : fingerprint_hex(fp);
     }
-    out << std::left << std::setw(static_cast<int>(width)) << c.channel << std::right
-        << std::setw(12) << c.received << std::setw(12) << c.written << std::setw(12) << c.throttled
-        << std::setw(8) << c.write_errors << std::setw(14) << c.bytes_written << "  " << types
-        << "\n";
+    out << fmt::format("{:<{}}{:>12}{:>12}{:>12}{:>8}{:>14}  {}\n", c.channel, width, c.received,
+                       c.written, c.throttled, c.write_errors, c.bytes_written, types);
   }
 }
 
