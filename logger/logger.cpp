@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -238,9 +237,8 @@ std::string Logger::finish(const Schema* schema) {
     transport_.unsubscribe(subscription_);
     subscription_ = -1;
   }
-  char name[64];
-  std::snprintf(name, sizeof name, "-%04d-summary.txt", writer_.first_file_number());
-  const std::string path = config_.dir + "/" + config_.prefix + name;
+  const std::string path = fmt::format("{}/{}-{:04d}-summary.txt", config_.dir, config_.prefix,
+                                       writer_.first_file_number());
   std::ofstream out(path);
   write_summary(out, schema);
   out.close();
