@@ -188,9 +188,10 @@ FinetuneResult finetune_policy(
 
   for (int it = 1; it <= config.iterations; ++it) {
     if (stop && stop()) break;
+    // Portable N(0, 1) draws, vectorised (a draw per parameter and pair every iteration).
     for (Eigen::VectorXf& eps : noise) {
       eps.resize(p);
-      for (Eigen::Index j = 0; j < p; ++j) eps[j] = static_cast<float>(nn::standard_normal(rng));
+      nn::fill_standard_normal(rng, eps);
     }
     // Sample s: pair s / 2, sign + for even s. Each worker takes every threads-th sample, so
     // the values do not depend on the number of threads.
