@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/random.hpp"
+
 namespace auvrl::agent {
 
 ExplorationNoise::Kind parse_noise_kind(const std::string& name) {
@@ -28,10 +30,10 @@ void ExplorationNoise::apply(task::ActionVector& action) {
   for (Eigen::Index i = 0; i < action.size(); ++i) {
     double n = 0.0;
     if (kind_ == Kind::kGaussian) {
-      n = sigma_ * normal_(rng_);
+      n = sigma_ * draw::standard_normal(rng_);
     } else {
       // Ornstein-Uhlenbeck, dt = one step: x += theta (0 - x) + sigma N(0, 1).
-      state_[i] += -theta_ * state_[i] + sigma_ * normal_(rng_);
+      state_[i] += -theta_ * state_[i] + sigma_ * draw::standard_normal(rng_);
       n = state_[i];
     }
     action[i] = static_cast<float>(std::clamp(static_cast<double>(action[i]) + n, -1.0, 1.0));

@@ -30,8 +30,7 @@ class ExplorationNoise {
   double sigma_;
   double theta_;
   Eigen::VectorXd state_;
-  std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  std::mt19937_64 rng_;  ///< draws N(0, 1) with draw::standard_normal (portable)
 };
 
 ExplorationNoise::Kind parse_noise_kind(const std::string& name);  ///< none | ou | gaussian

@@ -1,16 +1,16 @@
 #include "eval/evaluation.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <map>
 #include <ostream>
-#include <sstream>
 #include <stdexcept>
 
 #include "agent/pid_controller.hpp"
+#include "common/csv.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 
@@ -27,20 +27,32 @@ constexpr int kExtendedFixedInputs = 17;
 const Scenario kAllScenarios[] = {Scenario::kTest1, Scenario::kTest2, Scenario::kFault,
                                   Scenario::kCurrent, Scenario::kSuite};
 
-/// An ofstream that throws with the path on failure.
-std::ofstream open_for_writing(const std::string& path) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(path + ": cannot open for writing");
-  out << std::setprecision(9);
-  return out;
-}
+/// Digits of the numbers in summary.csv and the trajectories: enough to tell runs apart.
+constexpr int kCsvDigits = 9;
 
 /// -0 written as 0 (a zero pitch of a level vehicle comes out of the kinematics as -0).
 double tidy(double v) { return v == 0.0 ? 0.0 : v; }
 
-void finish(std::ofstream& out, const std::string& path) {
-  out.flush();
-  if (!out) throw std::runtime_error(path + ": write failed");
+std::vector<std::string> summary_columns() {
+  return {"scenario",      "controller",      "episode",
+          "goal_x",        "goal_y",          "goal_z",
+          "reached",       "time_to_reach_s", "mean_error_after_reach_m",
+          "final_error_m", "thrust_energy",   "end_reason"};
+}
+
+std::vector<std::string> trajectory_columns(int num_thrusters) {
+  std::vector<std::string> c{"t", "x", "y", "z", "phi", "theta", "psi",
+                             "u", "v", "w", "p", "q",   "r"};
+  for (int i = 1; i <= num_thrusters; ++i) c.push_back(fmt::format("cmd_{}", i));
+  for (int i = 1; i <= num_thrusters; ++i) c.push_back(fmt::format("thrust_{}", i));
+  c.push_back("distance_m");
+  return c;
+}
+
+std::string joined(const std::vector<std::string>& columns) {
+  std::string line;
+  for (const std::string& c : columns) line += (line.empty() ? "" : ",") + c;
+  return line;
 }
 
 }  // namespace
@@ -272,39 +284,31 @@ ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
   return score;
 }
 
-std::string summary_csv_header() {
-  return "scenario,controller,episode,goal_x,goal_y,goal_z,reached,time_to_reach_s,"
-         "mean_error_after_reach_m,final_error_m,thrust_energy,end_reason";
-}
+std::string summary_csv_header() { return joined(summary_columns()); }
 
 void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& rows) {
-  std::ofstream out = open_for_writing(path);
-  out << summary_csv_header() << '\n';
+  csv::Writer out(path, summary_columns(), csv::Mode::kTruncate, kCsvDigits);
   for (const SummaryRow& r : rows) {
-    out << r.scenario << ',' << r.controller << ',' << r.episode << ',' << r.goal_ned_m[0] << ','
-        << r.goal_ned_m[1] << ',' << r.goal_ned_m[2] << ',' << (r.reached ? 1 : 0) << ',';
+    out.cell(r.scenario).cell(r.controller).cell(r.episode);
+    out.cell(r.goal_ned_m[0]).cell(r.goal_ned_m[1]).cell(r.goal_ned_m[2]).cell(r.reached);
     if (r.reached) {
-      out << r.time_to_reach_s << ',' << r.mean_error_after_reach_m;
+      out.cell(r.time_to_reach_s).cell(r.mean_error_after_reach_m);
     } else {
-      out << ',';  // never reached: both cells empty
+      out.empty().empty();  // never reached: both cells empty
     }
-    out << ',' << r.final_error_m << ',' << r.thrust_energy << ',' << end_reason_name(r.end_reason)
-        << '\n';
+    out.cell(r.final_error_m).cell(r.thrust_energy).cell(end_reason_name(r.end_reason));
+    out.end_row();
   }
-  finish(out, path);
+  out.flush();
 }
 
 std::string trajectory_csv_header(int num_thrusters) {
-  std::string h = "t,x,y,z,phi,theta,psi,u,v,w,p,q,r";
-  for (int i = 1; i <= num_thrusters; ++i) h += ",cmd_" + std::to_string(i);
-  for (int i = 1; i <= num_thrusters; ++i) h += ",thrust_" + std::to_string(i);
-  return h + ",distance_m";
+  return joined(trajectory_columns(num_thrusters));
 }
 
 void write_trajectory_csv(const std::string& path, const std::vector<agent::TrajectoryRow>& rows,
                           int num_thrusters) {
-  std::ofstream out = open_for_writing(path);
-  out << trajectory_csv_header(num_thrusters) << '\n';
+  csv::Writer out(path, trajectory_columns(num_thrusters), csv::Mode::kTruncate, kCsvDigits);
   const auto n = static_cast<std::size_t>(num_thrusters);
   for (const agent::TrajectoryRow& r : rows) {
     if (r.thrust_command_n.size() != n || r.thrust_realised_n.size() != n) {
@@ -312,16 +316,17 @@ void write_trajectory_csv(const std::string& path, const std::vector<agent::Traj
                                   std::to_string(num_thrusters) + " thrusters");
     }
     const task::Observation& o = r.observation;
-    out << tidy(r.time_s);
+    out.cell(tidy(r.time_s));
     for (const Eigen::Vector3d* v :
          {&o.position_ned_m, &o.euler_rpy_rad, &o.velocity_body_mps, &o.angular_rate_body_rad_s}) {
-      out << ',' << tidy((*v)[0]) << ',' << tidy((*v)[1]) << ',' << tidy((*v)[2]);
+      out.cell(tidy((*v)[0])).cell(tidy((*v)[1])).cell(tidy((*v)[2]));
     }
-    for (double f : r.thrust_command_n) out << ',' << tidy(f);
-    for (double f : r.thrust_realised_n) out << ',' << tidy(f);
-    out << ',' << r.distance_m << '\n';
+    for (double f : r.thrust_command_n) out.cell(tidy(f));
+    for (double f : r.thrust_realised_n) out.cell(tidy(f));
+    out.cell(r.distance_m);
+    out.end_row();
   }
-  finish(out, path);
+  out.flush();
 }
 
 std::string format_summary_table(const std::vector<SummaryRow>& rows) {
@@ -345,30 +350,25 @@ std::string format_summary_table(const std::vector<SummaryRow>& rows) {
     t.final_error += r.final_error_m;
     t.energy += r.thrust_energy;
   }
-  std::ostringstream out;
-  out << std::fixed;
-  out << std::left << std::setw(9) << "scenario" << std::setw(12) << "controller" << std::right
-      << std::setw(10) << "reached" << std::setw(13) << "time [s]" << std::setw(14)
-      << "hold err [m]" << std::setw(15) << "final err [m]" << std::setw(10) << "energy" << '\n';
+  std::string out =
+      fmt::format("{:<9}{:<12}{:>10}{:>13}{:>14}{:>15}{:>10}\n", "scenario", "controller",
+                  "reached", "time [s]", "hold err [m]", "final err [m]", "energy");
   for (const std::string& name : order) {
     const Totals& t = by_scenario[name];
-    std::ostringstream reached;
-    reached << t.reached << "/" << t.episodes;
-    out << std::left << std::setw(9) << name << std::setw(12) << t.controller << std::right
-        << std::setw(10) << reached.str();
+    out += fmt::format("{:<9}{:<12}{:>10}", name, t.controller,
+                       fmt::format("{}/{}", t.reached, t.episodes));
     if (t.reached > 0) {
-      out << std::setw(13) << std::setprecision(1) << t.time / t.reached << std::setw(14)
-          << std::setprecision(2) << t.hold / t.reached;
+      out += fmt::format("{:>13.1f}{:>14.2f}", t.time / t.reached, t.hold / t.reached);
     } else {
-      out << std::setw(13) << "-" << std::setw(14) << "-";
+      out += fmt::format("{:>13}{:>14}", "-", "-");
     }
-    out << std::setw(15) << std::setprecision(2) << t.final_error / t.episodes << std::setw(10)
-        << std::setprecision(1) << t.energy / t.episodes << '\n';
+    out += fmt::format("{:>15.2f}{:>10.1f}\n", t.final_error / t.episodes, t.energy / t.episodes);
   }
-  out << "time and hold error: means over the reached episodes (reached = within 0.5 m);\n"
-         "final error and energy: means over all episodes; energy = sum over 0.1 s steps of "
-         "the\nmean squared normalised thruster command.\n";
-  return out.str();
+  out +=
+      "time and hold error: means over the reached episodes (reached = within 0.5 m);\n"
+      "final error and energy: means over all episodes; energy = sum over 0.1 s steps of "
+      "the\nmean squared normalised thruster command.\n";
+  return out;
 }
 
 task::StateLayout infer_layout(int input_dim, int num_thrusters) {

@@ -1,11 +1,12 @@
 #include "logger/log_tools.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <iomanip>
 #include <map>
 #include <memory>
 #include <ostream>
@@ -15,6 +16,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "common/csv.hpp"
 #include "logger/event_log.hpp"
 
 namespace auvrl::logger {
@@ -123,41 +125,35 @@ class ColumnSet {
   mutable bool dirty_ = false;
 };
 
-/// Writes the rows of one CSV file whose header is known in advance.
-class CsvWriter {
+/// The CSV of one channel (or of a filter's matches): a row per message, a column per field
+/// of the set (empty where a message lacks the field).
+class ChannelCsv {
  public:
-  CsvWriter(const std::string& path, const ColumnSet& columns)
-      : path_(path), columns_(columns), out_(path) {
-    if (!out_) throw std::runtime_error("cannot write " + path);
-    out_ << "utime_log_us,channel";
-    for (const std::string& name : columns.names()) out_ << "," << csv_cell(name);
-    out_ << "\n";
-    cells_.resize(columns.names().size());
-  }
+  ChannelCsv(const std::string& path, const ColumnSet& columns)
+      : columns_(columns), out_(path, header(columns)), cells_(columns.names().size()) {}
   void write_row(const LogEvent& event, const std::vector<FieldValue>& fields) {
     std::fill(cells_.begin(), cells_.end(), std::string());
     for (const FieldValue& field : fields) {
       const std::ptrdiff_t i = columns_.find(field.name);
       if (i >= 0) cells_[static_cast<std::size_t>(i)] = format_value(field);
     }
-    out_ << event.timestamp_us << "," << csv_cell(event.channel);
-    for (const std::string& cell : cells_) out_ << "," << csv_cell(cell);
-    out_ << "\n";
-    ++rows_;
+    out_.cell(event.timestamp_us).cell(event.channel);
+    for (const std::string& cell : cells_) out_.cell(cell);
+    out_.end_row();
   }
-  void close() {
-    out_.close();
-    if (!out_) throw std::runtime_error("error writing " + path_);
-  }
-  std::int64_t rows() const { return rows_; }
-  const std::string& path() const { return path_; }
+  void close() { out_.flush(); }
+  std::int64_t rows() const { return out_.rows(); }
+  const std::string& path() const { return out_.path(); }
 
  private:
-  std::string path_;
+  static std::vector<std::string> header(const ColumnSet& columns) {
+    std::vector<std::string> names{"utime_log_us", "channel"};
+    names.insert(names.end(), columns.names().begin(), columns.names().end());
+    return names;
+  }
   const ColumnSet& columns_;
-  std::ofstream out_;
+  csv::Writer out_;
   std::vector<std::string> cells_;
-  std::int64_t rows_ = 0;
 };
 
 /// File name for a channel's CSV: characters other than letters, digits, '_', '-' and '.'
@@ -232,16 +228,6 @@ bool matches(const std::vector<FieldValue>& fields,
 }
 
 }  // namespace
-
-std::string csv_cell(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"') quoted += '"';
-    quoted += c;
-  }
-  return quoted + "\"";
-}
 
 std::vector<std::string> split_csv_line(const std::string& line) {
   std::vector<std::string> cells(1);
@@ -319,23 +305,19 @@ int list_logs(const std::vector<std::string>& log_files, const Schema& schema, s
   out << log_files.size() << " file(s), " << total_file_bytes << " bytes, " << report.events
       << " events";
   if (report.events > 0) {
-    out << ", " << std::fixed << std::setprecision(3) << span_s << " s from " << utc_text(first)
-        << " to " << utc_text(last);
+    out << fmt::format(", {:.3f} s from {} to {}", span_s, utc_text(first), utc_text(last));
   }
   out << "\n\n";
   std::size_t width = 7;
   for (const std::string& channel : order) width = std::max(width, channel.size());
-  out << std::left << std::setw(static_cast<int>(width)) << "channel" << std::right << std::setw(10)
-      << "events" << std::setw(11) << "rate_hz" << std::setw(13) << "bytes"
-      << "  type\n";
+  out << fmt::format("{:<{}}{:>10}{:>11}{:>13}  type\n", "channel", width, "events", "rate_hz",
+                     "bytes");
   for (const std::string& channel : order) {
     const Stats& s = stats[channel];
     std::string rate = "-";
     if (s.events > 1 && s.last > s.first) {
-      std::ostringstream text;
-      text << std::fixed << std::setprecision(2)
-           << static_cast<double>(s.events - 1) / (static_cast<double>(s.last - s.first) * 1e-6);
-      rate = text.str();
+      rate = fmt::format("{:.2f}", static_cast<double>(s.events - 1) /
+                                       (static_cast<double>(s.last - s.first) * 1e-6));
     }
     std::string types;
     for (const auto& [fingerprint, count] : s.types) {
@@ -344,8 +326,8 @@ int list_logs(const std::vector<std::string>& log_files, const Schema& schema, s
       if (s.types.size() > 1) types += " (" + std::to_string(count) + ")";
     }
     if (types.empty()) types = "(too short for a fingerprint)";
-    out << std::left << std::setw(static_cast<int>(width)) << channel << std::right << std::setw(10)
-        << s.events << std::setw(11) << rate << std::setw(13) << s.bytes << "  " << types << "\n";
+    out << fmt::format("{:<{}}{:>10}{:>11}{:>13}  {}\n", channel, width, s.events, rate, s.bytes,
+                       types);
   }
   if (report.damaged_regions > 0) {
     out << "\ndamaged regions: " << report.damaged_regions << " (see messages on stderr)\n";
@@ -373,7 +355,7 @@ int export_logs(const std::vector<std::string>& log_files, const Schema& schema,
   });
   if (report.files_unreadable > 0) return kExitError;
   // Pass 2: the rows. Damage was reported in pass 1; the second pass reads the same events.
-  std::map<std::string, std::unique_ptr<CsvWriter>> writers;
+  std::map<std::string, std::unique_ptr<ChannelCsv>> writers;
   std::map<std::string, std::string> used_names;
   for (const auto& [channel, set] : columns) {
     std::string name = file_name_for(channel);
@@ -381,7 +363,7 @@ int export_logs(const std::vector<std::string>& log_files, const Schema& schema,
       name = file_name_for(channel) + "_" + std::to_string(n);
     }
     used_names[name] = channel;
-    writers[channel] = std::make_unique<CsvWriter>(options.out_dir + "/" + name + ".csv", set);
+    writers[channel] = std::make_unique<ChannelCsv>(options.out_dir + "/" + name + ".csv", set);
   }
   ReadReport second;
   std::ostringstream ignored;
@@ -444,7 +426,7 @@ int filter_logs(const std::vector<std::string>& log_files, const Schema& schema,
   const fs::path parent = fs::path(options.out_file).parent_path();
   std::error_code error;
   if (!parent.empty()) fs::create_directories(parent, error);
-  CsvWriter writer(options.out_file, matched_columns);
+  ChannelCsv writer(options.out_file, matched_columns);
   ReadReport second;
   std::ostringstream ignored;
   read_logs(log_files, second, ignored, [&](const std::string& file, const LogEvent& event) {

@@ -58,10 +58,7 @@ std::pair<std::string, std::string> parse_where(const std::string& text);
 int filter_logs(const std::vector<std::string>& log_files, const Schema& schema,
                 const FilterOptions& options, std::ostream& out, std::ostream& err);
 
-/// A CSV cell: quoted when it holds a comma, quote, CR or LF (quotes doubled).
-std::string csv_cell(const std::string& text);
-
-/// Splits one CSV line (as written by csv_cell) into cells.
+/// Splits one CSV line (cells quoted as csv::quote writes them) into cells.
 std::vector<std::string> split_csv_line(const std::string& line);
 
 }  // namespace auvrl::logger

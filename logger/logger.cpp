@@ -1,13 +1,12 @@
 #include "logger/logger.hpp"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <iomanip>
 #include <iostream>
 #include <stdexcept>
 
@@ -214,20 +213,16 @@ void Logger::write_summary(std::ostream& out, const Schema* schema) const {
       << " write_errors " << write_errors_ << "\n\n";
   std::size_t width = 8;
   for (const ChannelCounts& c : channels_) width = std::max(width, c.channel.size());
-  out << std::left << std::setw(static_cast<int>(width)) << "channel" << std::right << std::setw(12)
-      << "received" << std::setw(12) << "written" << std::setw(12) << "throttled" << std::setw(8)
-      << "errors" << std::setw(14) << "bytes"
-      << "  type\n";
+  out << fmt::format("{:<{}}{:>12}{:>12}{:>12}{:>8}{:>14}  type\n", "channel", width, "received",
+                     "written", "throttled", "errors", "bytes");
   for (const ChannelCounts& c : channels_) {
     std::string types;
     for (const std::uint64_t fp : c.fingerprints) {
       if (!types.empty()) types += ", ";
       types += schema != nullptr ? schema->names_for(fp) : fingerprint_hex(fp);
     }
-    out << std::left << std::setw(static_cast<int>(width)) << c.channel << std::right
-        << std::setw(12) << c.received << std::setw(12) << c.written << std::setw(12) << c.throttled
-        << std::setw(8) << c.write_errors << std::setw(14) << c.bytes_written << "  " << types
-        << "\n";
+    out << fmt::format("{:<{}}{:>12}{:>12}{:>12}{:>8}{:>14}  {}\n", c.channel, width, c.received,
+                       c.written, c.throttled, c.write_errors, c.bytes_written, types);
   }
 }
 
@@ -242,9 +237,8 @@ std::string Logger::finish(const Schema* schema) {
     transport_.unsubscribe(subscription_);
     subscription_ = -1;
   }
-  char name[64];
-  std::snprintf(name, sizeof name, "-%04d-summary.txt", writer_.first_file_number());
-  const std::string path = config_.dir + "/" + config_.prefix + name;
+  const std::string path = fmt::format("{}/{}-{:04d}-summary.txt", config_.dir, config_.prefix,
+                                       writer_.first_file_number());
   std::ofstream out(path);
   write_summary(out, schema);
   out.close();

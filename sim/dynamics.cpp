@@ -22,6 +22,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/random.hpp"
+
 namespace auvrl::sim {
 namespace {
 
@@ -305,13 +307,6 @@ StateStatus classify(const VehicleModel& model, const Vector6& eta, const Vector
   return StateStatus::kOk;
 }
 
-double standard_normal(std::mt19937_64& rng) {
-  // A fresh distribution per draw: no cached second value hides in an object, so the stream
-  // depends only on the engine (copying a state copies its whole random future).
-  std::normal_distribution<double> normal(0.0, 1.0);
-  return normal(rng);
-}
-
 Vector3 current_from_speed(const CurrentSettings& current, double speed_mps, double heading_rad) {
   return current.constant_velocity_ned_mps +
          speed_mps * Vector3(std::cos(heading_rad), std::sin(heading_rad), 0.0);
@@ -412,11 +407,11 @@ void step_impl(const VehicleModel& model, VehicleState& state,
                      (state.gauss_markov_speed_mps - cs.gauss_markov_speed_mean_mps) * dt /
                          cs.gauss_markov_time_constant_s;
   if (cs.gauss_markov_speed_sigma_mps > 0) {
-    speed_mps += cs.gauss_markov_speed_sigma_mps * std::sqrt(dt) * standard_normal(state.rng);
+    speed_mps += cs.gauss_markov_speed_sigma_mps * std::sqrt(dt) * draw::standard_normal(state.rng);
   }
   double heading_rad = cs.gauss_markov_direction_rad;
   if (cs.gauss_markov_direction_sigma_rad > 0) {
-    heading_rad += cs.gauss_markov_direction_sigma_rad * standard_normal(state.rng);
+    heading_rad += cs.gauss_markov_direction_sigma_rad * draw::standard_normal(state.rng);
   }
   const Vector3 current_ned_mps = current_from_speed(cs, speed_mps, heading_rad);
 
@@ -576,7 +571,7 @@ Measurement measure(const VehicleModel& /*model*/, VehicleState& state) {
   const auto add_noise = [&state](auto&& block, double sigma) {
     if (sigma > 0) {
       for (Eigen::Index i = 0; i < block.size(); ++i)
-        block(i) += sigma * standard_normal(state.rng);
+        block(i) += sigma * draw::standard_normal(state.rng);
     }
   };
   add_noise(out.eta.head<3>(), noise.position_sigma_m);

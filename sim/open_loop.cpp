@@ -1,6 +1,8 @@
 // Open-loop validation tool: CSV commands -> simulated trajectory CSV.
 #include "sim/open_loop.hpp"
 
+#include <fmt/format.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -9,6 +11,10 @@
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/csv.hpp"
 
 namespace auvrl::sim {
 namespace {
@@ -165,21 +171,19 @@ OpenLoopResult run_open_loop_commands(const VehicleModel& model, const ResetSett
 }
 
 void write_open_loop_csv(const std::string& path, const OpenLoopResult& result, int num_thrusters) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error(path + ": cannot open the output CSV for writing");
-  out << "t,x,y,z,phi,theta,psi,u,v,w,p,q,r";
-  for (int i = 1; i <= num_thrusters; ++i) out << ",thrust_" << i;
-  out << "\n";
-  out.precision(std::numeric_limits<double>::max_digits10);
+  std::vector<std::string> header{"t", "x", "y", "z", "phi", "theta", "psi",
+                                  "u", "v", "w", "p", "q",   "r"};
+  for (int i = 1; i <= num_thrusters; ++i) header.push_back(fmt::format("thrust_{}", i));
+  // Every digit of a double: the output reads back exactly.
+  csv::Writer out(path, header, csv::Mode::kTruncate, std::numeric_limits<double>::max_digits10);
   for (const OpenLoopSample& s : result.samples) {
-    out << s.time_s;
-    for (int i = 0; i < 6; ++i) out << ',' << s.eta(i);
-    for (int i = 0; i < 6; ++i) out << ',' << s.nu(i);
-    for (int i = 0; i < num_thrusters; ++i) out << ',' << s.thrust_realised_n(i);
-    out << '\n';
+    out.cell(s.time_s);
+    for (int i = 0; i < 6; ++i) out.cell(s.eta(i));
+    for (int i = 0; i < 6; ++i) out.cell(s.nu(i));
+    for (int i = 0; i < num_thrusters; ++i) out.cell(s.thrust_realised_n(i));
+    out.end_row();
   }
   out.flush();
-  if (!out) throw std::runtime_error(path + ": error while writing the output CSV");
 }
 
 int run_open_loop(const OpenLoopOptions& options, std::ostream& err) {

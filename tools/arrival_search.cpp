@@ -1,18 +1,18 @@
 #include "tools/arrival_search.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iomanip>
 #include <numeric>
 #include <ostream>
-#include <random>
-#include <sstream>
 #include <stdexcept>
 
 #include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
+#include "common/csv.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::tools {
 
@@ -181,8 +181,7 @@ ArrivalSearchResult search_fastest_arrival(
   double best_cost = cost_of(best_rollout);
 
   Eigen::MatrixXd sigma = Eigen::MatrixXd::Constant(segments, n, search.initial_sigma);
-  std::mt19937_64 rng(search.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
+  draw::Engine rng(search.seed);
   std::vector<Eigen::MatrixXd> samples(static_cast<std::size_t>(search.population));
   std::vector<std::pair<double, int>> ranked(static_cast<std::size_t>(search.population));
   std::vector<Rollout> rollouts(static_cast<std::size_t>(search.population));
@@ -195,7 +194,7 @@ ArrivalSearchResult search_fastest_arrival(
         x.resize(segments, n);
         for (int s = 0; s < segments; ++s) {
           for (int i = 0; i < n; ++i) {
-            x(s, i) = std::clamp(mean(s, i) + sigma(s, i) * normal(rng), -1.0, 1.0);
+            x(s, i) = std::clamp(mean(s, i) + sigma(s, i) * draw::standard_normal(rng), -1.0, 1.0);
           }
         }
       }
@@ -273,25 +272,65 @@ void OpenLoopController::act(const task::Observation& observation,
 void write_open_loop_commands_csv(const std::string& path,
                                   const std::vector<Eigen::VectorXd>& commands,
                                   double control_step_s, double max_thrust_n) {
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
   const Eigen::Index n = commands.empty() ? 0 : commands.front().size();
-  out << 't';
-  for (Eigen::Index i = 1; i <= n; ++i) out << ",f" << i;
-  out << '\n' << std::setprecision(17);
+  std::vector<std::string> header{"t"};
+  for (Eigen::Index i = 1; i <= n; ++i) header.push_back(fmt::format("f{}", i));
+  // 17 digits: the replay reads back exactly the searched thrusts.
+  csv::Writer out(path, header, csv::Mode::kTruncate, 17);
   for (std::size_t t = 0; t < commands.size(); ++t) {
     // Row t takes effect at the control step that starts at t * dt (auv_sim's rule).
-    out << static_cast<double>(t) * control_step_s;
-    for (Eigen::Index i = 0; i < n; ++i) out << ',' << commands[t][i] * max_thrust_n;
-    out << '\n';
+    out.cell(static_cast<double>(t) * control_step_s);
+    for (Eigen::Index i = 0; i < n; ++i) out.cell(commands[t][i] * max_thrust_n);
+    out.end_row();
   }
   // A last row of zeros at the end: auv_sim runs up to the last row's time by default, so
   // every command above is played, and none after.
-  out << static_cast<double>(commands.size()) * control_step_s;
-  for (Eigen::Index i = 0; i < n; ++i) out << ",0";
-  out << '\n';
-  if (!out) throw std::runtime_error("cannot write " + path);
+  out.cell(static_cast<double>(commands.size()) * control_step_s);
+  for (Eigen::Index i = 0; i < n; ++i) out.cell(0);
+  out.end_row();
+  out.flush();
 }
+
+namespace {
+
+/// search.csv: the best arrival step so far and the iteration's best, per iteration.
+void write_search_csv(const std::string& path, const ArrivalSearchResult& result) {
+  csv::Writer out(path, {"iteration", "best_arrival_step", "iteration_best_arrival_step"});
+  for (std::size_t i = 0; i < result.best_so_far_step.size(); ++i) {
+    out.row(static_cast<std::uint64_t>(i), result.best_so_far_step[i],
+            result.iteration_best_step[i]);
+  }
+  out.flush();
+}
+
+/// The closing lines: the PID's figures, the search's start and what the search found.
+std::string result_lines(const ArrivalSearchRequest& request, const ArrivalSearchResult& result,
+                         const std::vector<eval::SummaryRow>& rows, double dt) {
+  std::string lines =
+      fmt::format("PID baseline:             {:.1f} s (hold error after {:.2f} m, energy {:.1f})\n",
+                  rows[0].time_to_reach_s, rows[0].mean_error_after_reach_m, rows[0].thrust_energy);
+  lines += fmt::format("PID's commands, replayed: {:.1f} s (the search's start)\n",
+                       result.start_arrival_step * dt);
+  if (result.best_arrival_step <= 0) {
+    return lines + "soonest found:            none that counts (nor did the PID's replay)\n";
+  }
+  lines += fmt::format(
+      "soonest found:            {:.1f} s; with the PID holding after it: hold error {:.2f} m, "
+      "energy {:.1f}\n",
+      rows[1].time_to_reach_s, rows[1].mean_error_after_reach_m, rows[1].thrust_energy);
+  if (result.best_farthest_after_m >= 0) {
+    lines += fmt::format("  farthest in the {:.1f} s after arriving: {:.2f} m\n",
+                         request.search.stay_steps * dt, result.best_farthest_after_m);
+  }
+  namespace fs = std::filesystem;
+  lines += fmt::format(
+      "wrote {} (replay: auv_sim --vehicle FILE --open-loop commands.csv --out OUT.csv),\n"
+      "      summary.csv, search.csv and trajectories/ in {}\n",
+      (fs::path(request.out_dir) / "commands.csv").string(), request.out_dir);
+  return lines;
+}
+
+}  // namespace
 
 ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& request,
                                                std::ostream& out) {
@@ -314,18 +353,17 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
   fs::create_directories(fs::path(request.out_dir) / "trajectories", ec);
   if (ec) throw std::runtime_error("cannot create " + request.out_dir + ": " + ec.message());
 
-  out << "auvrl fastest: " << request.scenario << ", " << request.search.iterations
-      << " iterations of " << request.search.population << " samples (seed " << request.search.seed
-      << ")";
+  out << fmt::format("auvrl fastest: {}, {} iterations of {} samples (seed {})", request.scenario,
+                     request.search.iterations, request.search.population, request.search.seed);
   if (request.search.stay_within_m > 0) {
-    out << ", staying within " << request.search.stay_within_m << " m for "
-        << request.search.stay_steps * dt << " s after arriving";
+    out << fmt::format(", staying within {:g} m for {:g} s after arriving",
+                       request.search.stay_within_m, request.search.stay_steps * dt);
   }
   out << "\n";
   const ArrivalSearchResult result =
       search_fastest_arrival(model, config, episode, request.search, [&](int it, int best) {
         if ((it + 1) % 100 == 0) {
-          out << "  iteration " << (it + 1) << ": " << best * dt << " s\n" << std::flush;
+          out << fmt::format("  iteration {}: {:g} s\n", it + 1, best * dt) << std::flush;
         }
       });
 
@@ -349,40 +387,8 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
                                  result.commands, dt, config.task.max_thrust_n);
   }
   eval::write_summary_csv((fs::path(request.out_dir) / "summary.csv").string(), rows);
-  {
-    const std::string path = (fs::path(request.out_dir) / "search.csv").string();
-    std::ofstream csv(path);
-    csv << "iteration,best_arrival_step,iteration_best_arrival_step\n";
-    for (std::size_t i = 0; i < result.best_so_far_step.size(); ++i) {
-      csv << i << ',' << result.best_so_far_step[i] << ',' << result.iteration_best_step[i] << '\n';
-    }
-    if (!csv) throw std::runtime_error("cannot write " + path);
-  }
-
-  std::ostringstream lines;
-  lines << std::fixed << std::setprecision(1);
-  lines << "PID baseline:             " << rows[0].time_to_reach_s << " s (hold error after "
-        << std::setprecision(2) << rows[0].mean_error_after_reach_m << " m, energy "
-        << std::setprecision(1) << rows[0].thrust_energy << ")\n";
-  lines << "PID's commands, replayed: " << result.start_arrival_step * dt
-        << " s (the search's start)\n";
-  if (result.best_arrival_step > 0) {
-    lines << "soonest found:            " << rows[1].time_to_reach_s
-          << " s; with the PID holding after it: hold error " << std::setprecision(2)
-          << rows[1].mean_error_after_reach_m << " m, energy " << std::setprecision(1)
-          << rows[1].thrust_energy << "\n";
-    if (result.best_farthest_after_m >= 0) {
-      lines << "  farthest in the " << request.search.stay_steps * dt
-            << " s after arriving: " << std::setprecision(2) << result.best_farthest_after_m
-            << " m\n";
-    }
-    lines << "wrote " << (fs::path(request.out_dir) / "commands.csv").string()
-          << " (replay: auv_sim --vehicle FILE --open-loop commands.csv --out OUT.csv),\n"
-          << "      summary.csv, search.csv and trajectories/ in " << request.out_dir << "\n";
-  } else {
-    lines << "soonest found:            none that counts (nor did the PID's replay)\n";
-  }
-  out << lines.str();
+  write_search_csv((fs::path(request.out_dir) / "search.csv").string(), result);
+  out << result_lines(request, result, rows, dt);
   return result;
 }
 

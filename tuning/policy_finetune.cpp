@@ -16,6 +16,8 @@
 #include "agent/episode.hpp"
 #include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
+#include "common/nn/adam.hpp"
+#include "common/nn/random.hpp"
 
 namespace auvrl::tuning {
 
@@ -175,18 +177,21 @@ FinetuneResult finetune_policy(
   const Eigen::Index p = theta.size();
   result.start_objective = objective(workers[0], theta);
   result.best_objective = result.start_objective;
-  Eigen::VectorXf adam_m = Eigen::VectorXf::Zero(p), adam_v = Eigen::VectorXf::Zero(p);
-  std::mt19937_64 rng(seed ^ 0xE5E5E5E5ull);
-  std::normal_distribution<float> normal(0.0f, 1.0f);
+  // Kingma & Ba's defaults (beta 0.9 / 0.999, epsilon 1e-8), no decay, no clipping.
+  nn::AdamConfig adam_config;
+  adam_config.learning_rate = static_cast<float>(config.learning_rate);
+  nn::Adam adam(adam_config, p, 0);
+  nn::Rng rng(seed ^ 0xE5E5E5E5ull);
   const int samples = 2 * config.pairs;
   std::vector<Eigen::VectorXf> noise(static_cast<std::size_t>(config.pairs));
   std::vector<double> value(static_cast<std::size_t>(samples));
 
   for (int it = 1; it <= config.iterations; ++it) {
     if (stop && stop()) break;
+    // Portable N(0, 1) draws, vectorised (a draw per parameter and pair every iteration).
     for (Eigen::VectorXf& eps : noise) {
       eps.resize(p);
-      for (Eigen::Index j = 0; j < p; ++j) eps[j] = normal(rng);
+      nn::fill_standard_normal(rng, eps);
     }
     // Sample s: pair s / 2, sign + for even s. Each worker takes every threads-th sample, so
     // the values do not depend on the number of threads.
@@ -229,13 +234,9 @@ FinetuneResult finetune_policy(
                    noise[static_cast<std::size_t>(k)];
     }
     direction /= static_cast<float>(config.pairs * config.sigma);
-    adam_m = 0.9f * adam_m + 0.1f * direction;
-    adam_v = 0.999f * adam_v + 0.001f * direction.cwiseProduct(direction);
-    const float m_hat_scale = 1.0f / (1.0f - std::pow(0.9f, static_cast<float>(it)));
-    const float v_hat_scale = 1.0f / (1.0f - std::pow(0.999f, static_cast<float>(it)));
-    theta +=
-        static_cast<float>(config.learning_rate) *
-        ((adam_m.array() * m_hat_scale) / ((adam_v.array() * v_hat_scale).sqrt() + 1e-8f)).matrix();
+    // The direction lowers the objective; Adam descends, so it steps on the negative.
+    direction = -direction;
+    adam.step(theta, direction);
 
     FinetuneIteration stats;
     stats.iteration = it;

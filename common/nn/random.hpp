@@ -7,11 +7,15 @@
 
 #include "common/nn/byte_io.hpp"
 #include "common/nn/types.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::nn {
 
-/// The generator used everywhere in the learning core.
-using Rng = std::mt19937_64;
+/// The generator used everywhere in the learning core (the system's one, common/random.hpp).
+using Rng = draw::Engine;
+
+/// Scalar N(0, 1) in double, the same draw as the physics and the agents use.
+using draw::standard_normal;
 
 /// Uniform float in [0, 1) from the top 24 bits of one draw.
 inline float uniform01(Rng& rng) { return static_cast<float>(rng() >> 40) * 0x1.0p-24f; }

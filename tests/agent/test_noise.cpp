@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "agent/episode.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::agent {
 namespace {
@@ -90,6 +91,15 @@ TEST(ExplorationNoise, SameSeedSameNoiseOtherSeedOther) {
       differs |= xa != xc;
     }
     EXPECT_TRUE(differs);
+  }
+}
+
+TEST(ExplorationNoise, GaussianDrawsThePortableStandardNormal) {
+  // The same numbers with any standard library: sigma times draw::standard_normal of the seed.
+  ExplorationNoise noise(ExplorationNoise::Kind::kGaussian, 1, 0.1, 0.15, 2024);
+  draw::Engine rng(2024);
+  for (double v : draw(noise, 20)) {
+    EXPECT_FLOAT_EQ(static_cast<float>(v), static_cast<float>(0.1 * draw::standard_normal(rng)));
   }
 }
 

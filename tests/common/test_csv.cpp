@@ -49,6 +49,30 @@ TEST(CsvWriter, SignificantDigitsAreTheFilesChoice) {
   std::filesystem::remove(path);
 }
 
+// The files that moved onto the writer (evaluation 9 digits, searches and open loop 17) read
+// the same as when an ostream with setprecision wrote them.
+TEST(CsvWriter, NumbersMatchAnOstreamAtEveryPrecisionUsed) {
+  const double values[] = {0.0,       -0.0,          1.0,          -7.0,          0.1 + 0.2,
+                           1.0 / 3.0, 1e-7,          123456789.0,  6.02e23,       -2.5e-300,
+                           8.1,       119.344006123, 1e300 * 10.0, -1e300 * 10.0, 4.9e-324};
+  for (int digits : {6, 9, 17}) {
+    const std::string path = temp_path("auvrl_csv_precision.csv");
+    std::ostringstream expected;
+    expected.precision(digits);
+    expected << "x\n";
+    {
+      Writer w(path, {"x"}, Mode::kTruncate, digits);
+      for (double v : values) {
+        w.row(v);
+        expected << v << '\n';
+      }
+      w.flush();
+    }
+    EXPECT_EQ(read_all(path), expected.str()) << digits;
+    std::filesystem::remove(path);
+  }
+}
+
 TEST(CsvWriter, AppendWritesTheHeaderOnlyOnce) {
   const std::string path = temp_path("auvrl_csv_append.csv");
   std::filesystem::remove(path);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "child_process.hpp"
+#include "common/csv.hpp"
 #include "generated_types.hpp"
 #include "logger/event_log.hpp"
 #include "logger/log_tools.hpp"
@@ -271,10 +272,12 @@ TEST_F(LogTools, ExportOrdersTwoDimensionalColumnsRowByRow) {
   EXPECT_EQ(column(header, "fixed2d[0][0]"), column(header, "grid[2][0]") + 1);
 }
 
-TEST(Csv, CellsAreQuotedOnlyWhenNeeded) {
-  EXPECT_EQ(csv_cell("plain"), "plain");
-  EXPECT_EQ(csv_cell("a,b"), "\"a,b\"");
-  EXPECT_EQ(csv_cell("say \"hi\""), "\"say \"\"hi\"\"\"");
+TEST(Csv, SplitReadsWhatTheWriterQuotes) {
+  const std::vector<std::string> cells{"plain", "a,b", "say \"hi\"", "", "z"};
+  std::string line;
+  for (const std::string& c : cells) line += (line.empty() ? "" : ",") + auvrl::csv::quote(c);
+  EXPECT_EQ(line, "plain,\"a,b\",\"say \"\"hi\"\"\",,z");
+  EXPECT_EQ(split_csv_line(line), cells);
   EXPECT_EQ(split_csv_line("1,\"a,b\",\"x\"\"y\",,z"),
             (std::vector<std::string>{"1", "a,b", "x\"y", "", "z"}));
 }

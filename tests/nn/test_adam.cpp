@@ -54,6 +54,30 @@ TEST(Adam, MatchesHandComputedSteps) {
 
 // L2 decay adds weight_decay * w to the gradient of the first num_decayed entries (weights) and
 // leaves the rest (biases) alone.
+// The fine-tuning climbs along a direction: a step on its negative is Adam's ascent
+// theta += lr m_hat / (sqrt(v_hat) + eps), moments of the direction itself.
+TEST(Adam, StepOnTheNegatedDirectionAscends) {
+  AdamConfig config;
+  config.learning_rate = 0.01f;
+  const int n = 37;  // chunks of 16 and a tail
+  Adam adam(config, n, 0);
+  Vector theta = Vector::LinSpaced(n, -1.0f, 1.0f);
+  Vector expected = theta;
+  Vector m = Vector::Zero(n), v = Vector::Zero(n);
+  for (int t = 1; t <= 5; ++t) {
+    Vector direction(n);
+    for (int i = 0; i < n; ++i) direction[i] = std::sin(0.7f * static_cast<float>(i * t)) + 0.1f;
+    m = 0.9f * m + 0.1f * direction;
+    v = 0.999f * v + 0.001f * direction.cwiseProduct(direction);
+    const float m_scale = 1.0f / (1.0f - std::pow(0.9f, static_cast<float>(t)));
+    const float v_scale = 1.0f / (1.0f - std::pow(0.999f, static_cast<float>(t)));
+    expected += 0.01f * ((m.array() * m_scale) / ((v.array() * v_scale).sqrt() + 1e-8f)).matrix();
+    Vector descent = -direction;
+    adam.step(theta, descent);
+    for (int i = 0; i < n; ++i) EXPECT_NEAR(theta[i], expected[i], 1e-6f) << t << " " << i;
+  }
+}
+
 TEST(Adam, WeightDecayAppliesToWeightsOnly) {
   AdamConfig config;
   config.learning_rate = 0.01f;

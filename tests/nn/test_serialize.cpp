@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -45,6 +46,45 @@ TEST(Crc32, CheckValueAndSplitUpdates) {
     c.update(data.data() + cut, data.size() - cut);
     EXPECT_EQ(c.value(), whole) << cut;
   }
+}
+
+TEST(Crc32, MatchesTheValuesOfTheFormerHandWrittenTable) {
+  // Computed by the slicing-by-8 code that zlib replaced: stored checksums stay valid.
+  std::vector<std::uint8_t> data(100003);
+  for (std::size_t i = 0; i < data.size(); ++i) {
+    data[i] = static_cast<std::uint8_t>((i * 2654435761u) >> 13);
+  }
+  EXPECT_EQ(crc32(data.data(), data.size()), 0x732376CEu);
+  Crc32 c;
+  for (std::size_t at = 0; at < data.size(); at += 4099) {
+    c.update(data.data() + at, std::min<std::size_t>(4099, data.size() - at));
+  }
+  EXPECT_EQ(c.value(), 0x732376CEu);
+  Crc32 none;
+  none.update(nullptr, 0);
+  EXPECT_EQ(none.value(), 0u);
+}
+
+TEST(NetworkFormat, FilesWrittenBeforeZlibStillLoad) {
+  // A network file written by the former CRC code (params linearly spaced in [-0.75, 1.25]).
+  Mlp net(MlpSpec::actor(5, {7, 6}, 3), 1);
+  load_network_file(AUVRL_NN_TEST_DATA_DIR "/written_by_slicing_crc.nn", net);
+  Mlp expected(MlpSpec::actor(5, {7, 6}, 3), 1);
+  expected.params().setLinSpaced(-0.75f, 1.25f);
+  EXPECT_EQ(net.params(), expected.params());
+  EXPECT_EQ(network_to_bytes(net), read_file(AUVRL_NN_TEST_DATA_DIR "/written_by_slicing_crc.nn"));
+}
+
+TEST(NetworkFormat, CommittedPolicyLoadsWithItsChecksum) {
+  const std::vector<std::uint8_t> bytes = read_file(AUVRL_CONFIG_DIR "/policies/fast.nn");
+  const Mlp policy = network_from_bytes(bytes, 1);  // checks the CRC
+  EXPECT_GT(policy.num_params(), 0);
+  std::uint32_t stored;
+  std::memcpy(&stored, bytes.data() + bytes.size() - 4, 4);
+  EXPECT_EQ(stored, crc32(bytes.data(), bytes.size() - 4));
+  std::vector<std::uint8_t> flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  EXPECT_THROW(network_from_bytes(flipped, 1), std::runtime_error);
 }
 
 TEST(NetworkFormat, LayoutIsAsDocumented) {

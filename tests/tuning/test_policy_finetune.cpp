@@ -15,6 +15,7 @@
 #include "agent/pid_controller.hpp"
 #include "agent_test_util.hpp"
 #include "common/nn/file_io.hpp"
+#include "common/nn/random.hpp"
 #include "common/nn/serialize.hpp"
 #include "tuning/policy_finetune.hpp"
 
@@ -185,9 +186,10 @@ FinetuneConfig small_finetune() {
 /// find nothing better around it).
 nn::Mlp detuned_policy() {
   nn::Mlp policy = committed_policy();
-  std::mt19937 rng(7);
-  std::normal_distribution<float> normal(0.0f, 0.05f);
-  for (Eigen::Index i = 0; i < policy.params().size(); ++i) policy.params()[i] += normal(rng);
+  nn::Rng rng(7);
+  for (Eigen::Index i = 0; i < policy.params().size(); ++i) {
+    policy.params()[i] += 0.05f * static_cast<float>(nn::standard_normal(rng));
+  }
   return policy;
 }
 
