@@ -1,5 +1,10 @@
 #include "launcher/launcher.hpp"
 
+#include <unistd.h>
+
+#include <cstdlib>
+#include <stdexcept>
+
 #include "launcher/pipeline.hpp"
 #include "launcher/training.hpp"
 
@@ -20,6 +25,42 @@ int run_training(const TrainOptions& options, std::ostream& out) {
   const EvaluationResult evaluation = evaluate_stage(ctx, policy_path, out);
   report_stage(ctx, policy_path, evaluation, out);
   return 0;
+}
+
+std::vector<std::string> namespace_command(const TrainOptions& options) {
+  std::vector<std::string> args = {options.source_dir + "/scripts/netns.sh",
+                                   "--pidfile",
+                                   options.run_dir + "/netns.pid",
+                                   options.bin_dir + "/auvrl",
+                                   "train",
+                                   "--resume",
+                                   options.run_dir};
+  const auto pass = [&args](const char* flag, const std::string& value) {
+    args.insert(args.end(), {flag, value});
+  };
+  if (options.actors >= 0) pass("--actors", std::to_string(options.actors));
+  if (options.max_train_s >= 0) pass("--max-seconds", std::to_string(options.max_train_s));
+  if (options.seed >= 0) pass("--seed", std::to_string(options.seed));
+  if (options.finetune_iterations >= 0) {
+    pass("--finetune-iterations", std::to_string(options.finetune_iterations));
+  }
+  if (!options.evaluate) args.push_back("--no-eval");
+  args.insert(args.end(), options.transport_args.begin(), options.transport_args.end());
+  return args;
+}
+
+int start_training(TrainOptions options, bool host_network, std::ostream& out) {
+  const char* inside = std::getenv("AUVRL_IN_NETNS");
+  const bool in_namespace = inside != nullptr && std::string(inside) == "1";
+  if (!in_namespace) prepare_run_directory(options);
+  if (host_network || in_namespace) return run_training(options, out);
+  std::vector<std::string> args = namespace_command(options);
+  setenv("AUVRL_IN_NETNS", "1", 1);
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  execv(args[0].c_str(), argv.data());
+  throw std::runtime_error("cannot run " + args[0]);
 }
 
 }  // namespace auvrl::launcher

@@ -34,6 +34,17 @@ struct TrainOptions {
   std::vector<std::string> transport_args;
 };
 
+/// `auvrl train` once its options are parsed: prepares the run directory (a new run) or checks
+/// it (--resume), then runs the pipeline here when host_network is set or when this process
+/// already runs inside the private network namespace (AUVRL_IN_NETNS=1); otherwise runs
+/// `auvrl train --resume RUN` again inside a new private namespace (scripts/netns.sh, its PID
+/// in RUN/netns.pid for lcm-spy and the log tools) and does not return. Returns the exit code.
+int start_training(TrainOptions options, bool host_network, std::ostream& out);
+
+/// The command line that runs this training again inside a private network namespace: the
+/// run directory prepared, every option given passed on.
+std::vector<std::string> namespace_command(const TrainOptions& options);
+
 /// Runs the pipeline train -> select -> fine-tune -> evaluate -> report (already inside the
 /// network namespace, or with --network host). Returns the process exit code.
 int run_training(const TrainOptions& options, std::ostream& out);

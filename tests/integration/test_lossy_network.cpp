@@ -107,7 +107,7 @@ TEST(LossyNetwork, TrainingGoesOnWithTenPercentDatagramLoss) {
   const std::string dir = tmp + "/run";
   ChildProcess train(
       {test_support::bin_path("auvrl"), "train", "--config", config, "--run-dir", dir, "--network",
-       "host", "--actors", "1", "--max-seconds", "30", "--no-eval"},
+       "host", "--actors", "1", "--max-seconds", "30", "--finetune-iterations", "0", "--no-eval"},
       dir + ".log");
   const int status = train.wait_for_exit(std::chrono::seconds(120));
   ASSERT_TRUE(WIFEXITED(status)) << train.log();
