@@ -30,6 +30,12 @@ Writer& Writer::cell(double value) {
   return *this;
 }
 
+Writer& Writer::cell(Fixed number) {
+  separator();
+  out_ << fmt::format("{:.{}f}", number.value, number.decimals);
+  return *this;
+}
+
 Writer& Writer::cell(std::int64_t value) {
   separator();
   out_ << value;

@@ -17,6 +17,12 @@ enum class Mode {
   kAppend,    ///< rows added to an existing file; the header only when the file is new or empty
 };
 
+/// A number written with a fixed count of decimals (printf's %.Nf), e.g. times in telemetry.
+struct Fixed {
+  double value;
+  int decimals;
+};
+
 /// One CSV file written row by row. Numbers are written like printf's %.Ng (N significant
 /// digits, 6 by default, as an ostream writes them); text cells are quoted (RFC 4180) only when
 /// they hold a comma, a quote or a line break. Every failure throws std::runtime_error naming
@@ -28,6 +34,7 @@ class Writer {
 
   Writer& cell(double value);
   Writer& cell(float value) { return cell(static_cast<double>(value)); }
+  Writer& cell(Fixed number);
   Writer& cell(std::int64_t value);
   Writer& cell(std::uint64_t value);
   Writer& cell(int value) { return cell(static_cast<std::int64_t>(value)); }

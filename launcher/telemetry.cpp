@@ -15,7 +15,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /// A number with `decimals` digits after the point (the files' fixed-point columns).
-std::string fixed(double value, int decimals) { return fmt::format("{:.{}f}", value, decimals); }
+csv::Fixed fixed(double value, int decimals) { return {value, decimals}; }
 
 const std::vector<std::string> kQuickEvalHeader = {"wall_s",
                                                    "policy_version",

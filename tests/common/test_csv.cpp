@@ -73,6 +73,16 @@ TEST(CsvWriter, NumbersMatchAnOstreamAtEveryPrecisionUsed) {
   }
 }
 
+TEST(CsvWriter, FixedCellsKeepTheirDecimals) {
+  const std::string path = temp_path("auvrl_csv_fixed.csv");
+  {
+    Writer w(path, {"t", "rate"});
+    w.row(Fixed{12.0, 3}, Fixed{0.04999, 1});
+  }
+  EXPECT_EQ(read_all(path), "t,rate\n12.000,0.0\n");
+  std::filesystem::remove(path);
+}
+
 TEST(CsvWriter, AppendWritesTheHeaderOnlyOnce) {
   const std::string path = temp_path("auvrl_csv_append.csv");
   std::filesystem::remove(path);
