@@ -48,7 +48,7 @@ struct DdsSettings {
   int max_auto_participant_index = 120;
   /// Lockstep channels (SIM_CMD_/SIM_STATE_/...): reliable (true) or best effort. The sim
   /// client resends a command whose answer is missing, so best effort is safe too; the
-  /// README's benchmarks compare the two (bench_lockstep).
+  /// docs/results.md compares the two (bench_lockstep).
   bool lockstep_reliable = true;
 };
 

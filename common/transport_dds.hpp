@@ -28,7 +28,7 @@ namespace auvrl::transport {
 /// How long a queue-class publish may wait for a slow reader before it fails (back-pressure).
 /// Longer than Cyclone's participant lease (10 s): a reader whose process was killed holds the
 /// writer until its lease expires and it is dropped; the publish then goes on instead of
-/// failing (measured: a killed reader blocked experience writes for ~10 s, weights not at all).
+/// failing.
 inline constexpr std::chrono::milliseconds kDdsQueueMaxBlocking{15000};
 
 /// Opens a Cyclone DDS transport (one participant in settings.domain_id). Throws

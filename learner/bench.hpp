@@ -19,8 +19,7 @@ struct BenchCase {
   int batch = 256;
   /// Threads for the products (nn::set_num_threads). More than one pays only on an otherwise
   /// idle machine: each product ends at a barrier, and with more runnable threads than cores a
-  /// descheduled worker stalls the others for a time slice (measured here with the two cores
-  /// busy: 4-10 updates/s instead of hundreds).
+  /// descheduled worker stalls the others for a time slice.
   int threads = 1;
   int state_dim = 23;
   int action_dim = 6;

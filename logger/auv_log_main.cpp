@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
       "command's options.\n"
       "Exit codes: 0 ok, 1 error, 2 bad command line, 3 done but a log was damaged or held\n"
       "malformed messages (the damage and its byte offset are printed on stderr).\n"
-      "Replay a log onto LCM with lcm-logplayer inside the system's namespace (see README).");
+      "Replay a log onto LCM with lcm-logplayer inside the system's namespace (see docs/logs.md).");
   declare_commands(cmd, request);
   std::string command;
   try {

@@ -17,10 +17,7 @@
 # (uniform, clamped at 0) in user space, so a round trip on lo takes two such delays; else an
 # nftables rule that drops the loss share on input, without delay or jitter (it says so).
 # Root or user namespaces, as scripts/netns.sh.
-# Measured (README, Reliability; 2-core VM, load ~3.5): at 10% loss + 5ms +- 5ms, fast preset,
-# 1 actor, 60 s: clean ~12k env steps/s; impaired 56 with --lockstep-timeout-ms 30, 17 with the
-# default 200 (neither reached the warm-up); 300 s with 8 actors and 30 ms: 460 steps/s, 23 %
-# success at the end.
+# What it measured: docs/results.md (lossy network).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${AUVRL_BIN_DIR:-$root/build/bin}

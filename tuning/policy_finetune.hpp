@@ -9,10 +9,8 @@
 // error. Each iteration perturbs all the actor's weights in +-sigma * eps pairs, runs every
 // perturbed policy on a fixed set of way-points of the training region through the
 // evaluation's own episode code (agent::run_episode, as the evaluation runs it), ranks the results,
-// and moves the weights along the rank-weighted perturbations (Adam). Measured after 75 s of
-// TD3, seeds 1-3, 150 iterations (before the PID lag term): test1 8.8 / 8.8 / 8.7 s -> 8.2 /
-// 8.2 / 8.3 s, the suite's mean 9.4 / 9.3 / 10.0 s -> 8.4 / 8.5 / 8.7 s (README,
-// "Fine-tuning").
+// and moves the weights along the rank-weighted perturbations (nn::Adam). What it bought and
+// what was tried: docs/lab-notes/2026-11-24-finetuning.md.
 //
 // The objective's way-points are drawn from the task's goal region with a stream of their own
 // (never the evaluation's suite nor the launcher's validation way-points), from the task's
@@ -49,8 +47,7 @@ struct FinetuneConfig {
   /// Plus flip_margin_weight s per rad that |roll| or |pitch| ever exceeds flip_margin_rad:
   /// the rank-weighted steps otherwise learn to pitch ever further nose-down (surge then
   /// helps the slow heave), until a steep dive the few way-points did not include flips the
-  /// vehicle (1.2 rad). Without it a prototype lost 1-3 of the 100 suite way-points in 8 of
-  /// 12 fine-tunings; at 0.9 rad two of three seeds still lost one; at 0.7 none (README).
+  /// vehicle (1.2 rad).
   double flip_margin_rad = 0.7;
   double flip_margin_weight = 20.0;
   /// Each episode's length; a way-point not reached costs this time plus the closest
@@ -58,17 +55,13 @@ struct FinetuneConfig {
   int episode_steps = 250;
   /// Integrator steps per control step in the objective's episodes (0: the vehicle file's).
   /// They only rank perturbed weights; the validation and the evaluation run the vehicle's
-  /// own. Measured: with RK4 in 2 steps of 0.05 s instead of 10 of 0.01 s, the arrivals of
-  /// trained policies agree to ~1e-5 s, the mean objective over 24 way-points to 1e-6 s for a
-  /// TD3 policy and ~0.001 s for a fine-tuned one (whose hold term, thrusters working around
-  /// the way-point, moves by up to ~0.02 s on a way-point), at ~0.6 of the time per iteration.
+  /// own; a coarser integrator ranks them the same at a fraction of the cost.
   int integration_substeps = 0;
   /// Plus pid_lag_weight s per s that the arrival comes later than pid_lead_s before the PID
   /// baseline's on the same way-point (run once, before the first iteration). The mean alone
   /// lets a step trade a way-point the PID already reaches near the plant's limit (test1:
   /// PID 8.24 s, open loop 8.1 s with a stop) for a second elsewhere; the evaluation compares
-  /// with the PID per scenario. Measured on 7 trained policies, 200 iterations: test1 under
-  /// the PID's time from 6 of them (4 of 7 without it) (README, "Fine-tuning").
+  /// with the PID per scenario.
   double pid_lag_weight = 0.0;
   double pid_lead_s = 0.0;
   int threads = 2;  ///< policies evaluated at once (0: one per CPU)

@@ -6,10 +6,8 @@
 // first, and the bias and activation need passes of their own. With AVX-512 the kernels below
 // work on the operands where they lie (columns of A are contiguous, entries of B are
 // broadcast), keep a 64 x 6 block of C in registers and apply the epilogue before the only
-// store: 140-170 GFLOPS on one core here, against 110-150 for Eigen (the two AVX-512 FMA units
-// peak at ~208). Measured on whole TD3 updates (pendulum dims, one thread): 64-64 batch 100
-// 10,700 against 7,100 updates/s with Eigen's products; 256-256 and 400-400 batch 100 about
-// 1.1 times faster. Without AVX-512 (or with AUVRL_NN_PORTABLE) the same functions use Eigen's
+// store (faster than Eigen's products at these sizes: docs/results.md, benchmarks). Without
+// AVX-512 (or with AUVRL_NN_PORTABLE) the same functions use Eigen's
 // products plus an epilogue pass.
 #pragma once
 

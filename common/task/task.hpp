@@ -30,8 +30,7 @@ enum class StateLayout {
   /// reports it, normalised by the maximum thrust): 3 + 1 + 6 + 6 + n + 1 + n values. The
   /// thrusters ramp at only 5.5 % of full thrust per step and lag, so the previous command
   /// says little about the force acting; without it the policy cannot tell how hard it is
-  /// still pushing (measured: suite mean time to reach 17-21 s with the extended layout,
-  /// 10.4-10.5 s with this one).
+  /// still pushing (docs/lab-notes/2026-11-21-fast-preset-origins.md).
   kExtendedThrust,
 };
 
@@ -52,7 +51,7 @@ enum class RewardKind {
 RewardKind parse_reward_kind(const std::string& name);  ///< "paper" or "shaped"
 const char* to_string(RewardKind kind);
 
-/// Fixed scales that bring every input to roughly [-1, 1] (documented in the README).
+/// Fixed scales that bring every input to roughly [-1, 1] (docs/configuration.md, task.scales).
 struct ObservationScales {
   double position_m = 10.0;  ///< positions and goal errors
   double linear_velocity_mps = 1.0;
@@ -105,8 +104,8 @@ struct TaskConfig {
   /// pose). This share of training episodes starts in a random state: attitude uniform in
   /// start attitude +- start_attitude_spread_rad, body velocities uniform in
   /// +-start_velocity_max_body_mps and +-start_rate_max_body_rad_s. A policy that only ever
-  /// starts at rest never tries a second way of getting somewhere (measured: every policy
-  /// turned round and reversed to the way-point, even one straight ahead).
+  /// starts at rest never tries a second way of getting somewhere (every policy learnt to turn
+  /// round and reverse to the way-point, even one straight ahead).
   double random_start_fraction = 0.0;
   Eigen::Vector3d start_attitude_spread_rad = Eigen::Vector3d::Zero();    ///< roll, pitch, yaw
   Eigen::Vector3d start_velocity_max_body_mps = Eigen::Vector3d::Zero();  ///< u, v, w
