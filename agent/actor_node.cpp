@@ -7,6 +7,7 @@
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::agent {
 
@@ -131,7 +132,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   options.noise = &noise_;
   options.expert = config_.expert.get();
   // Drawn every episode, so the stream does not depend on the fraction's history.
-  last_was_demonstration_ = task::unit_draw(demonstration_rng_) < config_.demonstration_fraction;
+  last_was_demonstration_ = draw::unit(demonstration_rng_) < config_.demonstration_fraction;
   Controller& controller = last_was_demonstration_ ? *config_.demonstrator : *controller_;
   std::vector<Transition> transitions;
   transitions.reserve(static_cast<std::size_t>(config_.task.max_steps));

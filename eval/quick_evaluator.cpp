@@ -3,6 +3,7 @@
 #include <random>
 
 #include "agent/pid_controller.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::eval {
 
@@ -20,7 +21,7 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
   std::mt19937_64 rng(kValidationSeed + 1);
   for (int i = suite_episodes; i < suite_episodes + turned; ++i) {
     episodes_[static_cast<std::size_t>(i)].start.euler_rpy_rad[2] =
-        (2.0 * task::unit_draw(rng) - 1.0) * 3.14159265358979323846;
+        (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
   }
   agent::PidController pid(model_);
   reference_ = run(pid);

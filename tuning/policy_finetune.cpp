@@ -18,6 +18,7 @@
 #include "agent/vehicle_link.hpp"
 #include "common/nn/adam.hpp"
 #include "common/nn/random.hpp"
+#include "common/random.hpp"
 
 namespace auvrl::tuning {
 
@@ -61,7 +62,7 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
     e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
     // Spread the turned starts evenly through the list.
     if (turned > 0 && (i * turned) / config.episodes != ((i + 1) * turned) / config.episodes) {
-      e.start.euler_rpy_rad[2] = (2.0 * task::unit_draw(rng) - 1.0) * 3.14159265358979323846;
+      e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
     }
     e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
     episodes.push_back(e);

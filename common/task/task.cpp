@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/random.hpp"
+
 namespace auvrl::task {
 
 namespace {
@@ -229,14 +231,12 @@ StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, 
   return out;
 }
 
-double unit_draw(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
-
 namespace {
 /// Uniform in centre +- half_width, per component.
 Eigen::Vector3d spread_draw(const Eigen::Vector3d& centre, const Eigen::Vector3d& half_width,
                             std::mt19937_64& rng) {
   Eigen::Vector3d v;
-  for (int i = 0; i < 3; ++i) v[i] = centre[i] + (2.0 * unit_draw(rng) - 1.0) * half_width[i];
+  for (int i = 0; i < 3; ++i) v[i] = centre[i] + (2.0 * draw::unit(rng) - 1.0) * half_width[i];
   return v;
 }
 }  // namespace
@@ -244,7 +244,7 @@ Eigen::Vector3d spread_draw(const Eigen::Vector3d& centre, const Eigen::Vector3d
 Eigen::Vector3d sample_goal(const TaskConfig& c, std::mt19937_64& rng) {
   Eigen::Vector3d g;
   for (int i = 0; i < 3; ++i) {
-    g[i] = c.goal_min_ned_m[i] + unit_draw(rng) * (c.goal_max_ned_m[i] - c.goal_min_ned_m[i]);
+    g[i] = c.goal_min_ned_m[i] + draw::unit(rng) * (c.goal_max_ned_m[i] - c.goal_min_ned_m[i]);
   }
   return g;
 }
@@ -253,7 +253,7 @@ StartState sample_start(const TaskConfig& c, std::mt19937_64& rng) {
   StartState rest;
   rest.position_ned_m = c.start_position_ned_m;
   rest.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, c.start_yaw_rad);
-  const bool random = unit_draw(rng) < c.random_start_fraction;
+  const bool random = draw::unit(rng) < c.random_start_fraction;
   StartState drawn = rest;
   drawn.euler_rpy_rad = spread_draw(rest.euler_rpy_rad, c.start_attitude_spread_rad, rng);
   // Yaw wraps to (-pi, pi], the range the vehicle reports.

@@ -183,10 +183,6 @@ StepOutcome evaluate_step(const TaskConfig& config, double distance_before_m,
                           double distance_after_m, bool flipped, const ActionVector& action,
                           double beta_m, int steps_taken);
 
-/// Uniform in [0, 1) from rng, the same on every standard library (std::uniform_real_distribution
-/// is not): the draws of goals, starts and demonstrations reproduce across machines.
-double unit_draw(std::mt19937_64& rng);
-
 /// Draws a way-point uniformly in the configured box.
 Eigen::Vector3d sample_goal(const TaskConfig& config, std::mt19937_64& rng);
 

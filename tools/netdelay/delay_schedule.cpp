@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/random.hpp"
+
 namespace auvrl::netdelay {
 
 namespace {
@@ -50,12 +52,12 @@ DelaySchedule::DelaySchedule(const DelayOptions& options) : options_(options), r
 
 bool DelaySchedule::admit(std::uint32_t id, Clock::time_point now) {
   ++stats_.packets;
-  if (options_.loss > 0.0 && unit_(rng_) < options_.loss) {
+  if (options_.loss > 0.0 && draw::unit(rng_) < options_.loss) {
     ++stats_.dropped;
     return false;
   }
   double ms = options_.delay_ms;
-  if (options_.jitter_ms > 0.0) ms += options_.jitter_ms * (2.0 * unit_(rng_) - 1.0);
+  if (options_.jitter_ms > 0.0) ms += options_.jitter_ms * (2.0 * draw::unit(rng_) - 1.0);
   ms = std::max(ms, 0.0);
   stats_.delay_sum_ms += ms;
   const auto delay =

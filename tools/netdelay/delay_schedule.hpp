@@ -65,7 +65,6 @@ class DelaySchedule {
   };
   DelayOptions options_;
   std::mt19937_64 rng_;
-  std::uniform_real_distribution<double> unit_{0.0, 1.0};
   std::priority_queue<Held, std::vector<Held>, std::greater<Held>> heap_;
   std::uint64_t order_ = 0;
   DelayStats stats_;
