@@ -18,7 +18,7 @@ namespace auvrl::transport {
 /// Parses a comma-separated list of DDS peers ("127.0.0.1,10.0.0.2"); empty items are errors.
 std::vector<std::string> parse_peer_list(const std::string& text);
 
-/// Adds the transport flags to a command line (cli::CommandLine or logger::ToolCommandLine),
+/// Adds the transport flags to a command line (cli::CommandLine, any subcommand of it),
 /// bound to config. When given is set, every transport flag parsed is also appended to it as
 /// "--name" "value" (a launcher passes them on or merges them over a configuration file).
 template <class CommandLineT>
