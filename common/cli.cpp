@@ -105,7 +105,8 @@ void CommandLine::custom_flag(const std::string& name, std::function<void()> set
 
 void CommandLine::custom_option(const std::string& name,
                                 std::function<void(const std::string&)> parse,
-                                const std::string& default_text, const std::string& help) {
+                                const std::string& default_text, const std::string& help,
+                                const std::string& type_name) {
   const std::string option = "--" + name;
   // Called as each occurrence is parsed (in argv order, as the parse functions expect).
   app_->add_option_function<std::string>(
@@ -121,6 +122,7 @@ void CommandLine::custom_option(const std::string& name,
           },
           help)
       ->default_str(default_text)
+      ->type_name(type_name)
       ->trigger_on_parse();
 }
 

@@ -75,9 +75,11 @@ class CommandLine {
   /// --name (no value) calls set.
   void custom_flag(const std::string& name, std::function<void()> set, const std::string& help);
   /// --name VALUE handed to parse, which converts, checks and stores it; an exception it
-  /// throws becomes a UsageError naming the option. default_text is shown in --help.
+  /// throws becomes a UsageError naming the option. default_text is shown in --help, and
+  /// type_name as the value's kind (e.g. "number", "list").
   void custom_option(const std::string& name, std::function<void(const std::string&)> parse,
-                     const std::string& default_text, const std::string& help);
+                     const std::string& default_text, const std::string& help,
+                     const std::string& type_name = "TEXT");
   /// --name VALUE that may be given several times; every value is appended to *target.
   void repeatable(const std::string& name, std::vector<std::string>* target,
                   const std::string& help);

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cctype>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -222,8 +223,14 @@ class Table {
               if (!error.empty()) throw std::invalid_argument(error);
             }
           },
-          f.show(target), help);
+          f.show(target), help, upper(f.type));
     }
+  }
+
+  /// A field's type as --help shows it ("number" -> "NUMBER").
+  static std::string upper(std::string text) {
+    for (char& c : text) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return text;
   }
 
   /// The documentation rows, defaults from a default-constructed T.
