@@ -51,8 +51,8 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
     if (++window == report_every) {
       log << "auv_actor " << config.actor_id << ": episodes " << node.counters().episodes
           << ", policy v" << node.policy_version() << ", beta " << node.beta_m()
-          << " m, mean return " << return_sum / window << ", success " << successes << "/"
-          << window << "\n";
+          << " m, mean return " << return_sum / window << ", success " << successes << "/" << window
+          << "\n";
       return_sum = 0.0;
       successes = window = 0;
     }

@@ -13,10 +13,10 @@ namespace auvrl::agent {
 
 /// auv_actor's options that are not keys of ActorNodeConfig.
 struct ActorProcessOptions {
-  int vehicle_id = -1;      ///< its vehicle in auv_sim (-1: the actor id)
-  int pin_cpu = -1;         ///< pin the process to this CPU (-1: no)
-  int report_every = 50;    ///< a log line every N policy episodes
-  std::int64_t seed = 1;    ///< way-points and noise
+  int vehicle_id = -1;       ///< its vehicle in auv_sim (-1: the actor id)
+  int pin_cpu = -1;          ///< pin the process to this CPU (-1: no)
+  int report_every = 50;     ///< a log line every N policy episodes
+  std::int64_t seed = 1;     ///< way-points and noise
   std::string vehicle_path;  ///< the PID demonstrator's/expert's vehicle file
 };
 
