@@ -136,6 +136,8 @@ Rates measure(transport::Transport& monitor,
   return r;
 }
 
+/// One case: the simulators, auv_learner and `actors` actors in the given placement; prints the
+/// rates measured.
 void run_case(const transport::TransportConfig& config, int actors, double seconds,
               const std::string& learner_ratio, bool pinned) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");

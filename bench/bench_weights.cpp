@@ -189,6 +189,8 @@ void print_subscribers(const std::string& name, const std::string& hidden, const
   std::fflush(stdout);
 }
 
+/// One case: subscribers, auv_learner training on synthetic experience for `seconds`, the late
+/// joiner, then one line per subscriber.
 void run_case(const std::string& name, const transport::TransportConfig& config,
               const std::string& hidden, double seconds, int subscribers) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
