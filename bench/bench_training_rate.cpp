@@ -26,40 +26,35 @@ namespace {
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
 
-void run_case(const transport::TransportConfig& config, int actors, double seconds,
-              const std::string& learner_ratio, bool pinned) {
-  const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
-  auto monitor = transport::make_transport(config);
-  const std::vector<std::string> transport_args = transport::transport_arguments(config);
-  const bool dds = config.kind == transport::TransportKind::kDds;
-  std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
-  transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
-      *monitor, channels::kSimHeartbeat,
-      [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) { heartbeats[h.pid] = h; });
-  transport::Latest<auvrl_lcm::learner_stats_t> stats(*monitor, channels::kLearnerStats);
-  std::vector<std::unique_ptr<test_support::ChildProcess>> procs;
-  // The private lockstep bus of pair i (as auvrl train makes it).
-  const auto bus = [&](int i) -> std::vector<std::string> {
-    if (dds) return {"--lockstep-dds-domain", std::to_string(config.dds.domain_id + 1 + i)};
-    return {"--lockstep-lcm-url",
-            "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576"};
-  };
-  const int cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
-  for (int i = 0; i < (pinned ? actors : 1); ++i) {
-    std::vector<std::string> argv = {test_support::bin_path("auv_sim"), "--heartbeat-period",
-                                     "0.25"};
-    if (pinned) {
-      argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(i % cpus)});
-      argv.insert(argv.end(), {"--first-vehicle-id", std::to_string(i)});
-      const auto b = bus(i);
-      argv.insert(argv.end(), b.begin(), b.end());
-    } else {
-      argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
-    }
-    argv.insert(argv.end(), transport_args.begin(), transport_args.end());
-    procs.push_back(std::make_unique<test_support::ChildProcess>(
-        argv, dir + "/sim" + std::to_string(i) + ".log"));
+/// The private lockstep bus of pair i (as auvrl train makes it).
+std::vector<std::string> lockstep_bus_args(const transport::TransportConfig& config, int i) {
+  if (config.kind == transport::TransportKind::kDds) {
+    return {"--lockstep-dds-domain", std::to_string(config.dds.domain_id + 1 + i)};
   }
+  return {"--lockstep-lcm-url",
+          "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576"};
+}
+
+/// The command line of auv_sim number i: pinned, one vehicle on pair i's bus; shared, all.
+std::vector<std::string> sim_arguments(const transport::TransportConfig& config, int i, int actors,
+                                       bool pinned, int cpus) {
+  std::vector<std::string> argv = {test_support::bin_path("auv_sim"), "--heartbeat-period", "0.25"};
+  if (pinned) {
+    argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(i % cpus)});
+    argv.insert(argv.end(), {"--first-vehicle-id", std::to_string(i)});
+    const auto b = lockstep_bus_args(config, i);
+    argv.insert(argv.end(), b.begin(), b.end());
+  } else {
+    argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
+  }
+  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  argv.insert(argv.end(), transport_args.begin(), transport_args.end());
+  return argv;
+}
+
+/// auv_learner's command line: TD3, 64-64, at the given update ratio.
+std::vector<std::string> learner_arguments(const transport::TransportConfig& config,
+                                           const std::string& learner_ratio) {
   std::vector<std::string> learner_argv = {test_support::bin_path("auv_learner"),
                                            "--algo",
                                            "td3",
@@ -75,29 +70,47 @@ void run_case(const transport::TransportConfig& config, int actors, double secon
                                            "5000",
                                            "--replay-capacity",
                                            "200000"};
+  const std::vector<std::string> transport_args = transport::transport_arguments(config);
   learner_argv.insert(learner_argv.end(), transport_args.begin(), transport_args.end());
-  test_support::ChildProcess learner(learner_argv, dir + "/learner.log");
-  for (int id = 0; id < actors; ++id) {
-    std::vector<std::string> argv = {test_support::bin_path("auv_actor"),
-                                     "--actor-id",
-                                     std::to_string(id),
-                                     "--seed",
-                                     std::to_string(id + 1),
-                                     "--reward",
-                                     "shaped",
-                                     "--noise",
-                                     "gaussian",
-                                     "--layout",
-                                     "extended"};
-    if (pinned) {
-      argv.insert(argv.end(), {"--pin-cpu", std::to_string(id % cpus)});
-      const auto b = bus(id);
-      argv.insert(argv.end(), b.begin(), b.end());
-    }
-    argv.insert(argv.end(), transport_args.begin(), transport_args.end());
-    procs.push_back(std::make_unique<test_support::ChildProcess>(
-        argv, dir + "/actor" + std::to_string(id) + ".log"));
+  return learner_argv;
+}
+
+/// The command line of auv_actor `id` (pinned: on its CPU and pair id's bus).
+std::vector<std::string> actor_arguments(const transport::TransportConfig& config, int id,
+                                         bool pinned, int cpus) {
+  std::vector<std::string> argv = {test_support::bin_path("auv_actor"),
+                                   "--actor-id",
+                                   std::to_string(id),
+                                   "--seed",
+                                   std::to_string(id + 1),
+                                   "--reward",
+                                   "shaped",
+                                   "--noise",
+                                   "gaussian",
+                                   "--layout",
+                                   "extended"};
+  if (pinned) {
+    argv.insert(argv.end(), {"--pin-cpu", std::to_string(id % cpus)});
+    const auto b = lockstep_bus_args(config, id);
+    argv.insert(argv.end(), b.begin(), b.end());
   }
+  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  argv.insert(argv.end(), transport_args.begin(), transport_args.end());
+  return argv;
+}
+
+/// Rates over the measuring window.
+struct Rates {
+  double seconds = 0.0;
+  double steps_per_s = 0.0;
+  double updates_per_s = 0.0;
+};
+
+/// A 2 s warm-up, then environment steps (the simulators' heartbeats) and learner updates over
+/// `seconds`.
+Rates measure(transport::Transport& monitor,
+              const std::map<int, auvrl_lcm::sim_heartbeat_t>& heartbeats,
+              transport::Latest<auvrl_lcm::learner_stats_t>& stats, double seconds) {
   const auto total_steps = [&] {
     std::int64_t n = 0;
     for (const auto& [pid, h] : heartbeats) n += h.steps_total;
@@ -105,25 +118,53 @@ void run_case(const transport::TransportConfig& config, int actors, double secon
   };
   const auto pump = [&](double for_s) {
     const auto end = Clock::now() + std::chrono::duration<double>(for_s);
-    while (Clock::now() < end) monitor->handle(50);
+    while (Clock::now() < end) monitor.handle(50);
   };
   pump(2.0);  // warm-up: processes start, the learner starts updating
   const std::int64_t first = total_steps();
   std::optional<auvrl_lcm::learner_stats_t> first_stats = stats.take();
   const auto t0 = Clock::now();
   pump(seconds);
-  const double dt = std::chrono::duration<double>(Clock::now() - t0).count();
+  Rates r;
+  r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   std::optional<auvrl_lcm::learner_stats_t> last_stats = stats.take();
-  const double steps_per_s = static_cast<double>(total_steps() - first) / dt;
-  const double updates_per_s =
+  r.steps_per_s = static_cast<double>(total_steps() - first) / r.seconds;
+  r.updates_per_s =
       first_stats && last_stats
-          ? static_cast<double>(last_stats->updates - first_stats->updates) / dt
+          ? static_cast<double>(last_stats->updates - first_stats->updates) / r.seconds
           : 0.0;
+  return r;
+}
+
+/// One case: the simulators, auv_learner and `actors` actors in the given placement; prints the
+/// rates measured.
+void run_case(const transport::TransportConfig& config, int actors, double seconds,
+              const std::string& learner_ratio, bool pinned) {
+  const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
+  auto monitor = transport::make_transport(config);
+  std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
+  transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
+      *monitor, channels::kSimHeartbeat,
+      [&](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) { heartbeats[h.pid] = h; });
+  transport::Latest<auvrl_lcm::learner_stats_t> stats(*monitor, channels::kLearnerStats);
+  std::vector<std::unique_ptr<test_support::ChildProcess>> procs;
+  const int cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+  for (int i = 0; i < (pinned ? actors : 1); ++i) {
+    procs.push_back(std::make_unique<test_support::ChildProcess>(
+        sim_arguments(config, i, actors, pinned, cpus), dir + "/sim" + std::to_string(i) + ".log"));
+  }
+  test_support::ChildProcess learner(learner_arguments(config, learner_ratio),
+                                     dir + "/learner.log");
+  for (int id = 0; id < actors; ++id) {
+    procs.push_back(std::make_unique<test_support::ChildProcess>(
+        actor_arguments(config, id, pinned, cpus), dir + "/actor" + std::to_string(id) + ".log"));
+  }
+  const Rates r = measure(*monitor, heartbeats, stats, seconds);
   std::printf(
       "training transport=%s placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
       "updates_per_s=%.0f updates_per_transition=%s\n",
-      transport::to_string(config.kind).c_str(), pinned ? "pinned" : "shared", actors, dt,
-      steps_per_s, updates_per_s, learner_ratio.c_str());
+      transport::to_string(config.kind).c_str(), pinned ? "pinned" : "shared", actors, r.seconds,
+      r.steps_per_s, r.updates_per_s, learner_ratio.c_str());
   std::fflush(stdout);
 }
 

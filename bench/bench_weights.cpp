@@ -81,10 +81,10 @@ void late_joiner(const transport::TransportConfig& config, const std::string& re
   std::ofstream(result_path) << first_ms << " " << version << " " << count << "\n";
 }
 
-void run_case(const std::string& name, const transport::TransportConfig& config,
-              const std::string& hidden, double seconds, int subscribers) {
-  const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
-  const std::string stop_path = dir + "/stop";
+/// Forks `subscribers` subscriber processes (results in DIR/subK) and waits until each is ready.
+std::vector<pid_t> start_subscribers(const transport::TransportConfig& config,
+                                     const std::string& dir, const std::string& stop_path,
+                                     int subscribers) {
   std::vector<pid_t> children;
   for (int k = 0; k < subscribers; ++k) {
     const pid_t pid = fork();
@@ -99,6 +99,12 @@ void run_case(const std::string& name, const transport::TransportConfig& config,
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
   }
+  return children;
+}
+
+/// auv_learner's command line for an actor of `hidden` on `config`.
+std::vector<std::string> learner_arguments(const transport::TransportConfig& config,
+                                           const std::string& hidden) {
   std::vector<std::string> learner_argv = {test_support::bin_path("auv_learner"),
                                            "--state-dim",
                                            std::to_string(kStateDim),
@@ -111,66 +117,62 @@ void run_case(const std::string& name, const transport::TransportConfig& config,
                                            "--replay-capacity",
                                            "100000"};
   for (const std::string& a : transport::transport_arguments(config)) learner_argv.push_back(a);
-  test_support::ChildProcess learner(learner_argv, dir + "/learner.log");
-  auto transport = transport::make_transport(config);
-  transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
-  std::int64_t newest_version = -1;
-  transport::subscribe<auvrl_lcm::policy_summary_t>(
-      *transport, channels::kPolicySummary,
-      [&](const std::string&, const auvrl_lcm::policy_summary_t& s) {
-        newest_version = std::max(newest_version, s.version);
-      });
+  return learner_argv;
+}
+
+/// Experience at 2,000 transitions/s, in batches of 20 (an actor's rate on this machine), for
+/// `seconds`.
+void feed_experience(transport::Transport& transport, double seconds) {
   std::int64_t seq = 0;
-  // Experience at 2,000 transitions/s, in batches of 20 (an actor's rate on this machine).
   const auto end = Clock::now() + std::chrono::duration<double>(seconds);
   auto next = Clock::now();
   while (Clock::now() < end) {
     transport::publish(
-        *transport, channels::kExperience,
+        transport, channels::kExperience,
         test_support::synthetic_experience_batch(0, ++seq, 20, kStateDim, kActionDim));
     next += std::chrono::milliseconds(10);
     std::this_thread::sleep_until(next);
-    transport->drain();
+    transport.drain();
   }
-  // The late joiner: with the learner quiet (no experience, no broadcast), a new subscriber.
+}
+
+/// Handles messages until no new policy version (`newest_version`, updated by a subscription)
+/// has appeared for a second.
+void wait_until_quiet(transport::Transport& transport, const std::int64_t& newest_version) {
   auto quiet_since = Clock::now();
   std::int64_t seen = newest_version;
   while (Clock::now() - quiet_since < std::chrono::milliseconds(1000)) {
-    transport->handle(20);
+    transport.handle(20);
     if (newest_version != seen) {
       seen = newest_version;
       quiet_since = Clock::now();
     }
   }
-  std::int64_t published_before = -1;
-  if (auto s = stats.take()) published_before = s->weights_published;
+}
+
+/// The late joiner: a fresh process (exec, not fork: this one's transport has threads) that
+/// subscribes while the learner is quiet; prints what it got.
+void run_late_joiner(transport::Transport& transport, const std::string& name,
+                     const std::string& hidden, const std::string& dir,
+                     std::int64_t published_before, const std::int64_t& newest_version) {
   const std::string late_path = dir + "/late";
-  // A fresh process (exec, not fork: this one's transport has threads).
   test_support::ChildProcess late(
       {"/proc/self/exe", "--late-joiner", late_path, "--transport", name}, dir + "/late.log");
-  while (late.running()) transport->handle(10);
-  {
-    std::ifstream in(late_path);
-    double first_ms = -1;
-    long long version = -1, count = 0;
-    in >> first_ms >> version >> count;
-    std::printf(
-        "late_joiner transport=%s hidden=%s versions_published=%lld first_ms=%.2f version=%lld "
-        "newest=%lld count=%lld\n",
-        name.c_str(), hidden.c_str(), static_cast<long long>(published_before), first_ms, version,
-        static_cast<long long>(newest_version), count);
-  }
+  while (late.running()) transport.handle(10);
+  std::ifstream in(late_path);
+  double first_ms = -1;
+  long long version = -1, count = 0;
+  in >> first_ms >> version >> count;
+  std::printf(
+      "late_joiner transport=%s hidden=%s versions_published=%lld first_ms=%.2f version=%lld "
+      "newest=%lld count=%lld\n",
+      name.c_str(), hidden.c_str(), static_cast<long long>(published_before), first_ms, version,
+      static_cast<long long>(newest_version), count);
+}
 
-  // Stop the learner first so no weights are in flight, then read its final figures.
-  learner.terminate();
-  std::optional<auvrl_lcm::learner_stats_t> last;
-  for (int i = 0; i < 20; ++i) {
-    transport->handle(20);
-    if (auto s = stats.take()) last = s;
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  std::ofstream(stop_path) << "stop\n";
-  for (pid_t pid : children) waitpid(pid, nullptr, 0);
+/// One line per subscriber: what it received of what the learner published, and the latency.
+void print_subscribers(const std::string& name, const std::string& hidden, const std::string& dir,
+                       int subscribers, const std::optional<auvrl_lcm::learner_stats_t>& last) {
   const std::int64_t published = last ? last->weights_published : -1;
   for (int k = 0; k < subscribers; ++k) {
     std::ifstream in(dir + "/sub" + std::to_string(k));
@@ -185,6 +187,42 @@ void run_case(const std::string& name, const transport::TransportConfig& config,
         p99, static_cast<long long>(last ? last->updates : -1));
   }
   std::fflush(stdout);
+}
+
+/// One case: subscribers, auv_learner training on synthetic experience for `seconds`, the late
+/// joiner, then one line per subscriber.
+void run_case(const std::string& name, const transport::TransportConfig& config,
+              const std::string& hidden, double seconds, int subscribers) {
+  const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
+  const std::string stop_path = dir + "/stop";
+  const std::vector<pid_t> children = start_subscribers(config, dir, stop_path, subscribers);
+  test_support::ChildProcess learner(learner_arguments(config, hidden), dir + "/learner.log");
+  auto transport = transport::make_transport(config);
+  transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
+  std::int64_t newest_version = -1;
+  transport::subscribe<auvrl_lcm::policy_summary_t>(
+      *transport, channels::kPolicySummary,
+      [&](const std::string&, const auvrl_lcm::policy_summary_t& s) {
+        newest_version = std::max(newest_version, s.version);
+      });
+  feed_experience(*transport, seconds);
+  // The late joiner: with the learner quiet (no experience, no broadcast), a new subscriber.
+  wait_until_quiet(*transport, newest_version);
+  std::int64_t published_before = -1;
+  if (auto s = stats.take()) published_before = s->weights_published;
+  run_late_joiner(*transport, name, hidden, dir, published_before, newest_version);
+
+  // Stop the learner first so no weights are in flight, then read its final figures.
+  learner.terminate();
+  std::optional<auvrl_lcm::learner_stats_t> last;
+  for (int i = 0; i < 20; ++i) {
+    transport->handle(20);
+    if (auto s = stats.take()) last = s;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  std::ofstream(stop_path) << "stop\n";
+  for (pid_t pid : children) waitpid(pid, nullptr, 0);
+  print_subscribers(name, hidden, dir, subscribers, last);
 }
 
 }  // namespace

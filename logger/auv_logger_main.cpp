@@ -1,14 +1,13 @@
 // auv_logger: logs every channel (or a pattern) into rotating LCM event logs until SIGINT or
 // SIGTERM, then flushes, writes a summary of counts and exits. Parses the command line and
-// wires library pieces; the logic is in logger/logger.cpp.
+// wires library pieces; the logic is in logger/logger.cpp and logger/logger_process.cpp.
 #include <iostream>
 #include <memory>
 
 #include "common/cli.hpp"
-#include "common/signals.hpp"
-#include "common/transport.hpp"
 #include "common/transport_options.hpp"
 #include "logger/logger.hpp"
+#include "logger/logger_process.hpp"
 #include "logger/schema.hpp"
 
 int main(int argc, char** argv) {
@@ -40,37 +39,14 @@ int main(int argc, char** argv) {
   transport::add_transport_options(cmd, transport_config);
   try {
     if (!cmd.parse(argc, argv)) return 0;
-    for (const std::string& text : throttles) {
-      config.throttles.push_back(logger::parse_throttle_rule(text));
-    }
+    logger::add_throttle_rules(throttles, config);
   } catch (const std::exception& e) {
     std::cerr << "auv_logger: " << e.what() << "\n";
     return 2;
   }
-
-  // The types only name channels in the summary: a missing or broken types directory is
-  // reported but does not stop logging, which needs no type.
-  std::unique_ptr<logger::Schema> schema;
+  const std::unique_ptr<logger::Schema> schema = logger::load_summary_schema(types_dir, std::cerr);
   try {
-    schema = std::make_unique<logger::Schema>(logger::Schema::from_directories({types_dir}));
-  } catch (const logger::SchemaError& e) {
-    std::cerr << "auv_logger: warning: types not loaded, the summary shows fingerprints: "
-              << e.what() << "\n";
-  }
-
-  try {
-    auto transport = transport::make_transport(transport_config);
-    signals::install_stop_handlers();
-    logger::Logger logger(*transport, config);
-    std::cerr << "auv_logger: logging '" << config.channels << "' into " << config.dir << " ("
-              << transport::describe(transport_config) << ")\n";
-    while (!signals::stop_requested()) logger.poll(50);
-    const std::string summary = logger.finish(schema.get());
-    std::cerr << "auv_logger: stopped: received " << logger.received() << ", written "
-              << logger.written() << ", throttled " << logger.throttled() << ", write errors "
-              << logger.write_errors() << "; " << logger.writer().files().size()
-              << " files; summary " << summary << "\n";
-    return logger.write_errors() == 0 ? 0 : 1;
+    return logger::run_logger_process(config, transport_config, schema.get(), std::cerr);
   } catch (const std::exception& e) {
     std::cerr << "auv_logger: " << e.what() << "\n";
     return 1;

@@ -9,8 +9,36 @@
 #include "sim/open_loop.hpp"
 #include "sim/sim_server.hpp"
 
+namespace {
+
+using namespace auvrl;
+
+/// Serves the vehicles until a stop signal: the transports (and the lockstep bus if
+/// configured), the server, a start line and a final line of counts. Throws on errors.
+void serve(const std::string& vehicle_path, sim::SimServerConfig server, bool realtime,
+           const transport::TransportConfig& transport_config,
+           const transport::LockstepBusOptions& lockstep_bus) {
+  const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path);
+  server.lockstep = !realtime;
+  server.vehicle_file = vehicle_path;
+  auto transport = transport::make_transport(transport_config);
+  const auto lockstep_config = transport::lockstep_bus_config(transport_config, lockstep_bus);
+  std::unique_ptr<transport::Transport> lockstep;
+  if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
+  signals::install_stop_handlers();
+  sim::SimServer sim_server(model, lockstep ? *lockstep : *transport, server, transport.get());
+  std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " (" << vehicle_path
+            << "), " << (realtime ? "real time" : "lockstep") << ", "
+            << transport::describe(lockstep_config ? *lockstep_config : transport_config) << "\n";
+  sim_server.run([] { return signals::stop_requested(); });
+  const auto counters = sim_server.counters();
+  std::cerr << "auv_sim: stopped after " << counters.steps_total << " steps, "
+            << counters.resets_total << " resets\n";
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  using namespace auvrl;
   std::string vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
   sim::SimServerConfig server;
   transport::TransportConfig transport_config;
@@ -54,22 +82,7 @@ int main(int argc, char** argv) {
   }
 
   try {
-    const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path);
-    server.lockstep = !realtime;
-    server.vehicle_file = vehicle_path;
-    auto transport = transport::make_transport(transport_config);
-    const auto lockstep_config = transport::lockstep_bus_config(transport_config, lockstep_bus);
-    std::unique_ptr<transport::Transport> lockstep;
-    if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
-    signals::install_stop_handlers();
-    sim::SimServer sim_server(model, lockstep ? *lockstep : *transport, server, transport.get());
-    std::cerr << "auv_sim: " << server.num_vehicles << " x " << model.name << " (" << vehicle_path
-              << "), " << (realtime ? "real time" : "lockstep") << ", "
-              << transport::describe(lockstep_config ? *lockstep_config : transport_config) << "\n";
-    sim_server.run([] { return signals::stop_requested(); });
-    const auto counters = sim_server.counters();
-    std::cerr << "auv_sim: stopped after " << counters.steps_total << " steps, "
-              << counters.resets_total << " resets\n";
+    serve(vehicle_path, server, realtime, transport_config, lockstep_bus);
   } catch (const std::exception& e) {
     std::cerr << "auv_sim: " << e.what() << "\n";
     return 1;

@@ -115,45 +115,40 @@ Args parse_args(int argc, char** argv) {
   return a;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
-  const DelayOptions& options = args.options;
-  const long queue_num = args.queue_num;
-  const unsigned max_queued = args.max_queued;
-
+/// Opens NFQUEUE, binds args.queue_num to on_packet(ctx) and sets it up (metadata only, bounded,
+/// fail-open). Null (an error printed) when opening or binding fails.
+nfq_handle* open_queue(const Args& args, Context& ctx) {
   nfq_handle* handle = nfq_open();
   if (handle == nullptr) {
     std::fprintf(stderr, "auv_netdelay: nfq_open: %s\n", std::strerror(errno));
-    return 1;
+    return nullptr;
   }
-  DelaySchedule schedule(options);
-  Context ctx;
-  ctx.schedule = &schedule;
   nfq_bind_pf(handle, AF_INET);  // needed by kernels before 3.8 only; harmless after
-  ctx.queue = nfq_create_queue(handle, static_cast<std::uint16_t>(queue_num), &on_packet, &ctx);
+  ctx.queue =
+      nfq_create_queue(handle, static_cast<std::uint16_t>(args.queue_num), &on_packet, &ctx);
   if (ctx.queue == nullptr) {
     std::fprintf(stderr, "auv_netdelay: cannot bind queue %ld: %s (another holder? root?)\n",
-                 queue_num, std::strerror(errno));
+                 args.queue_num, std::strerror(errno));
     nfq_close(handle);
-    return 1;
+    return nullptr;
   }
   // Metadata only (the verdict needs the id, not the payload); a bounded kernel queue that
   // accepts rather than drops when full (fail-open).
   if (nfq_set_mode(ctx.queue, NFQNL_COPY_META, 0) < 0 ||
-      nfq_set_queue_maxlen(ctx.queue, max_queued) < 0) {
+      nfq_set_queue_maxlen(ctx.queue, args.max_queued) < 0) {
     std::fprintf(stderr, "auv_netdelay: queue setup failed: %s\n", std::strerror(errno));
-    return 1;
+    return nullptr;
   }
   if (nfq_set_queue_flags(ctx.queue, NFQA_CFG_F_FAIL_OPEN, NFQA_CFG_F_FAIL_OPEN) < 0) {
     std::fprintf(stderr, "auv_netdelay: warning: no fail-open in this kernel\n");
   }
   nfnl_rcvbufsiz(nfq_nfnlh(handle), 4u << 20);
-  const int fd = nfq_fd(handle);
-  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+  return handle;
+}
 
-  // SIGTERM/SIGINT blocked except while waiting in ppoll: no stop request is missed.
+/// Blocks SIGTERM/SIGINT and installs on_signal; returns the mask to wait with in ppoll (the
+/// old one with both unblocked), so that no stop request is missed.
+sigset_t block_stop_signals() {
   sigset_t block, wait_mask;
   sigemptyset(&block);
   sigaddset(&block, SIGTERM);
@@ -165,53 +160,75 @@ int main(int argc, char** argv) {
   action.sa_handler = on_signal;
   sigaction(SIGTERM, &action, nullptr);
   sigaction(SIGINT, &action, nullptr);
+  return wait_mask;
+}
 
-  std::fprintf(stderr,
-               "auv_netdelay: queue %ld bound: delay %.3f ms, jitter %.3f ms (uniform), "
-               "loss %.2f %%, seed %llu, max queued %u\n",
-               queue_num, options.delay_ms, options.jitter_ms, 100.0 * options.loss,
-               static_cast<unsigned long long>(options.seed), max_queued);
+/// The ppoll timeout until the schedule's next due time in *storage; null when nothing is held.
+timespec* timeout_to_next_due(const DelaySchedule& schedule, timespec* storage) {
+  const auto next = schedule.next_due();
+  if (!next) return nullptr;
+  const auto wait = std::max(*next - Clock::now(), Clock::duration::zero());
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
+  storage->tv_sec = static_cast<time_t>(ns / 1000000000);
+  storage->tv_nsec = static_cast<long>(ns % 1000000000);
+  return storage;
+}
 
+/// Hands every message waiting on the (non-blocking) socket to the library, which calls
+/// on_packet; counts kernel overruns (ENOBUFS) in *overruns.
+void drain_socket(nfq_handle* handle, int fd, std::vector<char>& buffer, std::uint64_t* overruns) {
+  for (;;) {
+    const ssize_t n = recv(fd, buffer.data(), buffer.size(), 0);
+    if (n < 0) {
+      if (errno == ENOBUFS) {  // the kernel dropped messages to us: fail-open covers them
+        ++*overruns;
+        continue;
+      }
+      break;  // EAGAIN: drained
+    }
+    nfq_handle_packet(handle, buffer.data(), static_cast<int>(n));
+  }
+}
+
+/// Holds and releases packets until a stop signal (or a ppoll error), then accepts every held
+/// packet. Returns the socket overruns.
+std::uint64_t serve(nfq_handle* handle, Context& ctx, const sigset_t& wait_mask) {
+  const int fd = nfq_fd(handle);
+  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
   std::vector<char> buffer(1 << 16);
   std::vector<std::uint32_t> due;
   std::uint64_t overruns = 0;
   while (!g_stop) {
     timespec timeout{};
-    timespec* timeout_ptr = nullptr;
-    if (const auto next = schedule.next_due()) {
-      const auto wait = std::max(*next - Clock::now(), Clock::duration::zero());
-      const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count();
-      timeout.tv_sec = static_cast<time_t>(ns / 1000000000);
-      timeout.tv_nsec = static_cast<long>(ns % 1000000000);
-      timeout_ptr = &timeout;
-    }
     pollfd pfd{fd, POLLIN, 0};
-    const int ready = ppoll(&pfd, 1, timeout_ptr, &wait_mask);
+    const int ready = ppoll(&pfd, 1, timeout_to_next_due(*ctx.schedule, &timeout), &wait_mask);
     if (ready < 0 && errno != EINTR) {
       std::fprintf(stderr, "auv_netdelay: ppoll: %s\n", std::strerror(errno));
       break;
     }
-    if (ready > 0) {
-      for (;;) {
-        const ssize_t n = recv(fd, buffer.data(), buffer.size(), 0);
-        if (n < 0) {
-          if (errno == ENOBUFS) {  // the kernel dropped messages to us: fail-open covers them
-            ++overruns;
-            continue;
-          }
-          break;  // EAGAIN: drained
-        }
-        nfq_handle_packet(handle, buffer.data(), static_cast<int>(n));
-      }
-    }
+    if (ready > 0) drain_socket(handle, fd, buffer, &overruns);
     due.clear();
-    schedule.release_due(Clock::now(), due);
+    ctx.schedule->release_due(Clock::now(), due);
     accept_all(ctx, due);
   }
   due.clear();
-  schedule.release_all(due);
+  ctx.schedule->release_all(due);
   accept_all(ctx, due);
-  const DelayStats& s = schedule.stats();
+  return overruns;
+}
+
+/// The start line: the queue and the impairment.
+void print_start(const Args& args) {
+  const DelayOptions& options = args.options;
+  std::fprintf(stderr,
+               "auv_netdelay: queue %ld bound: delay %.3f ms, jitter %.3f ms (uniform), "
+               "loss %.2f %%, seed %llu, max queued %u\n",
+               args.queue_num, options.delay_ms, options.jitter_ms, 100.0 * options.loss,
+               static_cast<unsigned long long>(options.seed), args.max_queued);
+}
+
+/// The final counts.
+void print_stats(const DelayStats& s, std::uint64_t overruns, std::uint64_t verdict_errors) {
   const std::uint64_t delayed = s.packets - s.dropped;
   std::fprintf(stderr,
                "auv_netdelay: %llu packets: %llu delayed (mean %.3f ms), %llu dropped (%.2f %%), "
@@ -220,7 +237,22 @@ int main(int argc, char** argv) {
                delayed ? s.delay_sum_ms / delayed : 0.0, static_cast<unsigned long long>(s.dropped),
                s.packets ? 100.0 * s.dropped / s.packets : 0.0, s.max_pending,
                static_cast<unsigned long long>(overruns),
-               static_cast<unsigned long long>(ctx.verdict_errors));
+               static_cast<unsigned long long>(verdict_errors));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv);
+  DelaySchedule schedule(args.options);
+  Context ctx;
+  ctx.schedule = &schedule;
+  nfq_handle* handle = open_queue(args, ctx);
+  if (handle == nullptr) return 1;
+  const sigset_t wait_mask = block_stop_signals();
+  print_start(args);
+  const std::uint64_t overruns = serve(handle, ctx, wait_mask);
+  print_stats(schedule.stats(), overruns, ctx.verdict_errors);
   nfq_destroy_queue(ctx.queue);
   nfq_close(handle);
   return 0;

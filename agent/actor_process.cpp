@@ -1,0 +1,81 @@
+#include "agent/actor_process.hpp"
+
+#include <sched.h>
+
+#include <memory>
+#include <stdexcept>
+
+#include "agent/pid_controller.hpp"
+#include "common/signals.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace auvrl::agent {
+
+void finish_actor_config(const ActorProcessOptions& options, ActorNodeConfig& config) {
+  config.vehicle_id = options.vehicle_id >= 0 ? options.vehicle_id : config.actor_id;
+  config.seed = static_cast<std::uint64_t>(options.seed);
+  config.task.validate();
+  if (config.demonstration_fraction <= 0 && !config.expert_labels) return;
+  if (options.vehicle_path.empty()) {
+    throw std::invalid_argument(
+        "demonstrations and expert labels need the vehicle file (vehicle: in the run file, "
+        "or --vehicle)");
+  }
+  const sim::VehicleModel model = sim::load_vehicle_file(options.vehicle_path);
+  // Two instances: the PID keeps integrator state per episode it follows.
+  if (config.demonstration_fraction > 0) {
+    config.demonstrator = std::make_shared<PidController>(model);
+  }
+  if (config.expert_labels) config.expert = std::make_shared<PidController>(model);
+}
+
+bool pin_to_cpu(int cpu, std::ostream& log) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof set, &set) == 0) return true;
+  log << "auv_actor: cannot pin to CPU " << cpu << " (continuing unpinned)\n";
+  return false;
+}
+
+void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int report_every,
+                        std::ostream& log) {
+  double return_sum = 0.0;
+  int successes = 0, window = 0;
+  while (!signals::stop_requested() && !node.training_done() &&
+         (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
+    const EpisodeSummary s = node.run_one_episode();
+    if (node.last_was_demonstration()) continue;  // the window is the policy's
+    return_sum += s.episode_return;
+    successes += s.success ? 1 : 0;
+    if (++window == report_every) {
+      log << "auv_actor " << config.actor_id << ": episodes " << node.counters().episodes
+          << ", policy v" << node.policy_version() << ", beta " << node.beta_m()
+          << " m, mean return " << return_sum / window << ", success " << successes << "/" << window
+          << "\n";
+      return_sum = 0.0;
+      successes = window = 0;
+    }
+  }
+  const auto& c = node.counters();
+  log << "auv_actor " << config.actor_id << ": stopped after " << c.episodes << " episodes, "
+      << c.steps << " steps, " << c.transitions_sent << " transitions sent, "
+      << c.episodes_discarded << " discarded\n";
+}
+
+void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions& options,
+                       const transport::TransportConfig& transport_config,
+                       const transport::LockstepBusOptions& lockstep_bus, std::ostream& log) {
+  auto transport = transport::make_transport(transport_config);
+  const auto lockstep_config = transport::lockstep_bus_config(transport_config, lockstep_bus);
+  std::unique_ptr<transport::Transport> lockstep;
+  if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
+  signals::install_stop_handlers();
+  ActorNode node(config, *transport, log, lockstep.get());
+  log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
+      << task::to_string(config.task.layout) << " state (" << config.task.state_dim() << "), "
+      << task::to_string(config.task.reward) << " reward, seed " << options.seed << "\n";
+  run_actor_episodes(node, config, options.report_every, log);
+}
+
+}  // namespace auvrl::agent
