@@ -177,7 +177,7 @@ constexpr const char* kConfigDocPreamble =
     "(config/presets/*.yaml); unknown keys are errors. The keys of `learner:` are also\n"
     "auv_learner's flags, those of `task:` and `actor:` auv_actor's (`replay_capacity` is\n"
     "`--replay-capacity`, `scales.depth_m` is `--scales-depth-m`; a bool `key` has `--key`\n"
-    "and `--no-key`). The last two sections are blocks of a vehicle file (config/vehicles/).\n";
+    "and `--no-key`). The last section is a vehicle file (config/vehicles/).\n";
 
 /// `auvrl config-doc`: prints docs/configuration.md.
 int run_config_doc(int argc, const char* const* argv) {
@@ -194,8 +194,7 @@ int run_config_doc(int argc, const char* const* argv) {
       config::section_doc(auvrl::launcher::run_table()),
       config::section_doc(auvrl::launcher::finetune_table()),
       config::section_doc(auvrl::transport::transport_table()),
-      config::section_doc(auvrl::sim::thruster_dynamics_table()),
-      config::section_doc(auvrl::sim::blow_up_limits_table())};
+      auvrl::sim::vehicle_file_doc()};
   std::cout << config::render_markdown(sections, kConfigDocPreamble);
   return 0;
 }
