@@ -202,6 +202,8 @@ std::string flag_name(const std::string& key) {
   return out;
 }
 
+double shown_number(const std::string& text) { return std::strtod(text.c_str(), nullptr); }
+
 std::string format_range(double lo, double hi) {
   if (std::isinf(hi)) return fmt::format(">= {}", lo);
   if (std::isinf(lo)) return fmt::format("<= {}", hi);

@@ -45,6 +45,9 @@ AUVRL_CONFIG_CODEC(Eigen::Vector3d, "[x, y, z]");
 AUVRL_CONFIG_CODEC(std::vector<std::vector<double>>, "list of lists of numbers");
 #undef AUVRL_CONFIG_CODEC
 
+/// A number as show() wrote it, back (strtod: never throws, even on a denormal).
+double shown_number(const std::string& text);
+
 /// "[1, 2, 3]" (shortest round-trip numbers).
 std::string show_numbers(const double* values, int n);
 /// Exactly n numbers ("1,2,3" or "[1, 2, 3]"); throws std::invalid_argument.
@@ -194,7 +197,7 @@ class Table {
     f.unit = f.unit.empty() ? text : f.unit + ", " + text;
     auto show = f.show;
     f.check = [show, text, lo, hi](T& t) {
-      const double v = std::stod(show(t));
+      const double v = shown_number(show(t));
       return v >= lo && v <= hi ? std::string() : "expected " + text + ", got " + show(t);
     };
     return *this;
@@ -206,7 +209,7 @@ class Table {
     f.unit = f.unit.empty() ? "> 0" : f.unit + ", > 0";
     auto show = f.show;
     f.check = [show](T& t) {
-      return std::stod(show(t)) > 0 ? std::string() : "expected > 0, got " + show(t);
+      return shown_number(show(t)) > 0 ? std::string() : "expected > 0, got " + show(t);
     };
     return *this;
   }
