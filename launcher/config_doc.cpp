@@ -23,7 +23,7 @@ constexpr const char* kPreamble =
     "(config/presets/*.yaml); unknown keys are errors. The keys of `learner:` are also\n"
     "auv_learner's flags, those of `task:` and `actor:` auv_actor's (`replay_capacity` is\n"
     "`--replay-capacity`, `scales.depth_m` is `--scales-depth-m`; a bool `key` has `--key`\n"
-    "and `--no-key`). The last two sections are blocks of a vehicle file (config/vehicles/).\n";
+    "and `--no-key`). The last section is a vehicle file (config/vehicles/).\n";
 
 }  // namespace
 
@@ -36,8 +36,7 @@ std::string configuration_reference() {
       config::section_doc(run_table()),
       config::section_doc(finetune_table()),
       config::section_doc(transport::transport_table()),
-      config::section_doc(sim::thruster_dynamics_table()),
-      config::section_doc(sim::blow_up_limits_table())};
+      sim::vehicle_file_doc()};
   return config::render_markdown(sections, kPreamble);
 }
 

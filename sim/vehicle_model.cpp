@@ -1,7 +1,8 @@
-// Vehicle file loading (yaml-cpp) and model finalisation: derived matrices and validation.
+// Vehicle file loading (config::Table per block, see common/config/table.hpp) and model
+// finalisation: derived matrices and validation.
 //
 // File layout (every key required, unknown keys rejected so that a typo cannot silently fall
-// back to a default):
+// back to a default; docs/configuration.md lists every key):
 //
 //   name: string
 //   rigid_body:        mass_kg, inertia_kg_m2 ([Ix, Iy, Iz] or a 3x3 list of rows, about the
@@ -31,9 +32,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <initializer_list>
-#include <set>
 #include <sstream>
+#include <stdexcept>
 #include <utility>
 
 #include "common/config/table.hpp"
@@ -60,147 +60,129 @@ Matrix3 skew(const Vector3& a) {
   return s;
 }
 
-// ---- YAML reading: structure, types, sizes and unknown keys. --------------------------------
+// ---- YAML reading: one config::Table per block (types, sizes, unknown and missing keys). ----
 
-/// Reads one file; every error names the file, the dotted field path and the line.
-class FileReader {
- public:
-  explicit FileReader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const std::string& field, const std::string& what,
-                         const YAML::Node* node = nullptr) const {
-    std::string where;
-    if (node != nullptr && node->Mark().line >= 0) {
-      where = " (line " + std::to_string(node->Mark().line + 1) + ")";
-    }
-    throw VehicleFileError(file_, field, what + where);
-  }
-
-  /// A map whose keys are all among `allowed` (presence is checked where each is read).
-  void check_map(const YAML::Node& node, const std::string& field,
-                 std::initializer_list<const char*> allowed) const {
-    if (!node.IsMap()) fail(field, "expected a map of keys", &node);
-    std::set<std::string> known(allowed.begin(), allowed.end());
-    for (const auto& entry : node) {
-      // A complex key ("? [a, b]: ...") is valid YAML but no name (found by fuzz_vehicle_yaml).
-      if (!entry.first.IsScalar()) fail(field, "expected names as keys", &entry.first);
-      const std::string key = entry.first.Scalar();
-      if (known.count(key) == 0) {
-        std::string list;
-        for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);
-        fail(join(field, key), "unknown key (expected one of: " + list + ")", &entry.first);
-      }
-    }
-  }
-
-  YAML::Node require(const YAML::Node& map, const std::string& field,
-                     const std::string& key) const {
-    YAML::Node child = map[key];
-    if (!child.IsDefined() || child.IsNull()) {
-      if (field.empty()) fail(key, "missing");
-      fail(join(field, key), "missing from the block '" + field + "' starting at line " +
-                                 std::to_string(map.Mark().line + 1));
-    }
-    return child;
-  }
-
-  double number(const YAML::Node& node, const std::string& field) const {
-    if (!node.IsScalar()) fail(field, "expected a number", &node);
-    double value = 0;
-    try {
-      value = node.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(field, "expected a number, got '" + node.Scalar() + "'", &node);
-    }
-    if (!std::isfinite(value)) fail(field, "expected a finite number, got " + node.Scalar(), &node);
-    return value;
-  }
-
-  double number(const YAML::Node& map, const std::string& field, const std::string& key) const {
-    return number(require(map, field, key), join(field, key));
-  }
-
-  bool boolean(const YAML::Node& map, const std::string& field, const std::string& key) const {
-    const YAML::Node node = require(map, field, key);
-    try {
-      return node.as<bool>();
-    } catch (const YAML::Exception&) {
-      fail(join(field, key), "expected true or false, got '" + node.Scalar() + "'", &node);
-    }
-  }
-
-  int integer(const YAML::Node& map, const std::string& field, const std::string& key) const {
-    const YAML::Node node = require(map, field, key);
-    try {
-      return node.as<int>();
-    } catch (const YAML::Exception&) {
-      fail(join(field, key), "expected an integer, got '" + node.Scalar() + "'", &node);
-    }
-  }
-
-  std::string text(const YAML::Node& map, const std::string& field, const std::string& key) const {
-    const YAML::Node node = require(map, field, key);
-    if (!node.IsScalar()) fail(join(field, key), "expected a string", &node);
-    return node.Scalar();
-  }
-
-  /// A list of exactly n finite numbers.
-  Eigen::VectorXd vector(const YAML::Node& map, const std::string& field, const std::string& key,
-                         int n) const {
-    const YAML::Node node = require(map, field, key);
-    const std::string path = join(field, key);
-    if (!node.IsSequence() || static_cast<int>(node.size()) != n) {
-      fail(path,
-           "expected a list of " + std::to_string(n) + " numbers" +
-               (node.IsSequence() ? ", got " + std::to_string(node.size()) : std::string()),
-           &node);
-    }
-    Eigen::VectorXd v(n);
-    for (int i = 0; i < n; ++i) v(i) = number(node[i], path + "[" + std::to_string(i) + "]");
-    return v;
-  }
-
-  /// [Ix, Iy, Iz] (principal axes) or three rows of three (full tensor about the CG).
-  Matrix3 inertia(const YAML::Node& map, const std::string& field, const std::string& key) const {
-    const YAML::Node node = require(map, field, key);
-    const std::string path = join(field, key);
-    const char* expected = "expected [Ix, Iy, Iz] or a 3x3 list of rows";
-    if (!node.IsSequence() || node.size() != 3) fail(path, expected, &node);
-    Matrix3 inertia = Matrix3::Zero();
-    if (node[0].IsScalar()) {
-      for (int i = 0; i < 3; ++i) {
-        inertia(i, i) = number(node[i], path + "[" + std::to_string(i) + "]");
-      }
-      return inertia;
-    }
-    for (int r = 0; r < 3; ++r) {
-      const YAML::Node row = node[r];
-      if (!row.IsSequence() || row.size() != 3) fail(path, expected, &row);
-      for (int c = 0; c < 3; ++c) {
-        inertia(r, c) =
-            number(row[c], path + "[" + std::to_string(r) + "][" + std::to_string(c) + "]");
-      }
-    }
-    return inertia;
-  }
-
-  static std::string join(const std::string& field, const std::string& key) {
-    return field.empty() ? key : field + "." + key;
-  }
-
- private:
-  std::string file_;
+/// A vehicle file as written: the model plus the hydrostatic figures it is derived from.
+struct VehicleFile {
+  VehicleModel model;
+  double gravity_mps2 = 0;
+  double buoyancy_n = 0;  ///< given directly, or
+  double displaced_volume_m3 = 0;
+  double water_density_kg_m3 = 0;  ///< B = rho g V
+  bool buoyancy_from_volume = false;
 };
 
-/// Reads a block through its table; errors keep VehicleFileError's field and line.
-template <class T>
-void read_block(const std::string& file, const YAML::Node& node, const std::string& key,
-                const config::Table<T>& table, T& target) {
-  try {
-    table.read(config::Section(file, key, node), target);
-  } catch (const config::ConfigError& e) {
-    throw VehicleFileError(file, e.key().empty() ? key : e.key(), e.detail());
+/// Every block of a vehicle file reads into the same VehicleFile (an identity accessor).
+VehicleFile& whole(VehicleFile& f) { return f; }
+
+Integrator parse_integrator(const std::string& text) {
+  if (text == "rk4") return Integrator::kRk4;
+  if (text == "semi_implicit_euler") return Integrator::kSemiImplicitEuler;
+  throw std::invalid_argument("expected rk4 or semi_implicit_euler, got '" + text + "'");
+}
+
+const char* integrator_name(Integrator integrator) {
+  return integrator == Integrator::kRk4 ? "rk4" : "semi_implicit_euler";
+}
+
+config::Table<VehicleFile> make_rigid_body_table() {
+  using F = VehicleFile;
+  config::Table<F> t("rigid_body", "mass and inertia");
+  t.field(
+       "mass_kg", [](F& f) -> double& { return f.model.mass_kg; }, "kg", "mass")
+      .required()
+      .positive();
+  t.field(
+       "inertia_kg_m2", [](F& f) -> Matrix3& { return f.model.inertia_kg_m2; }, "kg m^2",
+       "inertia tensor about the CG: [Ix, Iy, Iz] (principal axes) or 3 rows")
+      .required();
+  t.field(
+       "cog_body_m", [](F& f) -> Vector3& { return f.model.cog_body_m; }, "m",
+       "centre of gravity r_g from the body origin (the centre of buoyancy)")
+      .required();
+  return t;
+}
+
+/// Buoyancy is given either directly or as rho g V, never both.
+void check_buoyancy(const config::Section& s, VehicleFile& f) {
+  const bool has_buoyancy = s.has("buoyancy_n");
+  const bool has_volume = s.has("displaced_volume_m3") || s.has("water_density_kg_m3");
+  if (has_buoyancy == has_volume) {
+    s.fail("buoyancy_n",
+           "give either buoyancy_n or both displaced_volume_m3 and water_density_kg_m3");
   }
+  for (const char* key : {"displaced_volume_m3", "water_density_kg_m3"}) {
+    if (has_volume && !s.has(key)) s.fail(key, "missing (needed with the other of the pair)");
+  }
+  f.buoyancy_from_volume = has_volume;
+}
+
+config::Table<VehicleFile> make_hydrostatics_table() {
+  using F = VehicleFile;
+  config::Table<F> t("hydrostatics",
+                     "weight and buoyancy: buoyancy_n, or displaced_volume_m3 and "
+                     "water_density_kg_m3 (B = rho g V)");
+  t.field("gravity_mps2", &F::gravity_mps2, "m/s^2", "W = m g").required().positive();
+  t.field(
+       "cob_body_m", [](F& f) -> Vector3& { return f.model.cob_body_m; }, "m",
+       "centre of buoyancy r_b")
+      .required();
+  t.field("buoyancy_n", &F::buoyancy_n, "N", "buoyancy B (or the next two)").positive();
+  t.field("displaced_volume_m3", &F::displaced_volume_m3, "m^3", "displaced volume V").positive();
+  t.field("water_density_kg_m3", &F::water_density_kg_m3, "kg/m^3", "water density rho").positive();
+  t.validate(check_buoyancy);
+  return t;
+}
+
+config::Table<VehicleFile> make_hydrodynamics_table() {
+  using F = VehicleFile;
+  config::Table<F> t("hydrodynamics", "added mass and damping, SNAME signs (each <= 0)");
+  t.field(
+       "added_mass_derivatives", [](F& f) -> Vector6& { return f.model.added_mass_derivatives; },
+       "kg, kg m^2", "[X_udot Y_vdot Z_wdot K_pdot M_qdot N_rdot]")
+      .required();
+  t.field(
+       "linear_damping", [](F& f) -> Vector6& { return f.model.linear_damping; }, "",
+       "[X_u Y_v Z_w K_p M_q N_r]")
+      .required();
+  t.field(
+       "quadratic_damping", [](F& f) -> Vector6& { return f.model.quadratic_damping; }, "",
+       "[X_uu Y_vv Z_ww K_pp M_qq N_rr]")
+      .required();
+  t.field(
+       "added_mass_coriolis", [](F& f) -> bool& { return f.model.added_mass_coriolis; }, "",
+       "include C_A(nu_r) (the Munk moment)")
+      .required();
+  return t;
+}
+
+config::Table<Thruster> make_thruster_table() {
+  config::Table<Thruster> t("thrusters", "where each thruster sits and which way it pushes");
+  t.field("name", &Thruster::name, "", "label").required();
+  t.field("position_body_m", &Thruster::position_body_m, "m", "from the body origin").required();
+  t.field("direction_body", &Thruster::direction_body, "", "unit vector of positive thrust")
+      .required();
+  return t;
+}
+
+config::Table<VehicleFile> make_integration_table() {
+  using F = VehicleFile;
+  config::Table<F> t("integration", "time step and integrator");
+  t.field(
+       "control_step_s", [](F& f) -> double& { return f.model.control_step_s; }, "s",
+       "control step")
+      .required()
+      .positive();
+  t.choice(
+       "integrator", [](F& f) -> Integrator& { return f.model.integrator; }, parse_integrator,
+       integrator_name, "rk4, semi_implicit_euler", "integration scheme")
+      .required();
+  t.field(
+       "substeps", [](F& f) -> int& { return f.model.substeps; }, "",
+       "integrator steps per control step")
+      .required()
+      .range(1);
+  return t;
 }
 
 config::Table<ThrusterDynamics> make_thruster_dynamics_table() {
@@ -226,6 +208,70 @@ config::Table<BlowUpLimits> make_blow_up_limits_table() {
   t.field("max_angular_rate_rad_s", &C::max_angular_rate_rad_s, "rad/s", "body rate").required();
   t.field("max_position_m", &C::max_position_m, "m", "distance from the origin").required();
   return t;
+}
+
+config::Table<VehicleFile> make_vehicle_file_table() {
+  using F = VehicleFile;
+  config::Table<F> t("vehicle file",
+                     "A vehicle (config/vehicles/*.yaml): every block and key is required "
+                     "(there are no defaults) and unknown keys are errors.");
+  t.field(
+       "name", [](F& f) -> std::string& { return f.model.name; }, "", "the vehicle's name")
+      .required();
+  t.section("rigid_body", make_rigid_body_table(), whole).required();
+  t.section("hydrostatics", make_hydrostatics_table(), whole).required();
+  t.section("hydrodynamics", make_hydrodynamics_table(), whole).required();
+  t.list(
+       "thrusters", make_thruster_table(),
+       [](F& f) -> std::vector<Thruster>& { return f.model.thrusters; }, 1,
+       static_cast<std::size_t>(kMaxThrusters))
+      .required();
+  t.section("thruster_dynamics", thruster_dynamics_table(), [](F& f) -> ThrusterDynamics& {
+     return f.model.thruster_dynamics;
+   }).required();
+  t.section("integration", make_integration_table(), whole).required();
+  t.section("blow_up_limits", blow_up_limits_table(), [](F& f) -> BlowUpLimits& {
+     return f.model.blow_up;
+   }).required();
+  return t;
+}
+
+const config::Table<VehicleFile>& vehicle_file_table() {
+  static const config::Table<VehicleFile> table = make_vehicle_file_table();
+  return table;
+}
+
+/// The file's YAML; a missing file or a syntax error is a VehicleFileError.
+YAML::Node load_yaml(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw VehicleFileError(path, "(file)", "cannot open the file");
+  } catch (const YAML::ParserException& e) {
+    throw VehicleFileError(path, "(syntax)", e.what());
+  }
+}
+
+/// Reads every block through vehicle_file_table(); ConfigError becomes VehicleFileError with
+/// the same dotted field and line.
+VehicleFile read_vehicle_file(const std::string& path, const YAML::Node& root) {
+  VehicleFile file;
+  try {
+    vehicle_file_table().read(config::Section(path, "", root), file);
+  } catch (const config::ConfigError& e) {
+    const std::string field = e.key().empty() ? "(top level)" : e.key();
+    throw VehicleFileError(path, field, e.detail().empty() ? e.what() : e.detail());
+  }
+  return file;
+}
+
+/// Weight and buoyancy from the hydrostatics block (W = m g; B given or rho g V).
+void apply_hydrostatics(VehicleFile& file) {
+  VehicleModel& model = file.model;
+  model.weight_n = model.mass_kg * file.gravity_mps2;
+  model.buoyancy_n = file.buoyancy_from_volume
+                         ? file.water_density_kg_m3 * file.gravity_mps2 * file.displaced_volume_m3
+                         : file.buoyancy_n;
 }
 
 // ---- Model-level validation (shared by files and models built in code). ---------------------
@@ -264,26 +310,8 @@ class ModelChecker {
   std::string file_;
 };
 
-}  // namespace
-
-int allocation_rank(const AllocationMatrix& allocation) {
-  // Fixed sizes only (no heap, no dynamic GEMM kernels): zero columns pad B to 6 x kMax without
-  // changing its singular values, which are the square roots of the eigenvalues of B B^T.
-  Eigen::Matrix<double, 6, kMaxThrusters> padded = Eigen::Matrix<double, 6, kMaxThrusters>::Zero();
-  padded.leftCols(allocation.cols()) = allocation;
-  const Matrix6 gram = padded * padded.transpose();
-  const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(gram, Eigen::EigenvaluesOnly);
-  int rank = 0;
-  for (int i = 0; i < 6; ++i) {
-    if (std::sqrt(std::max(eigen.eigenvalues()(i), 0.0)) >= kAllocationMinSingularValue) ++rank;
-  }
-  return rank;
-}
-
-void finalize_vehicle_model(VehicleModel& model) {
-  const ModelChecker check(model);
-
-  // Rigid body and hydrostatics.
+/// Mass, weight, buoyancy, centres and the inertia tensor (positive definite, symmetric).
+void check_rigid_body(const ModelChecker& check, const VehicleModel& model) {
   check.positive(model.mass_kg, "rigid_body.mass_kg");
   check.positive(model.weight_n, "weight_n (rigid_body.mass_kg * hydrostatics.gravity_mps2)");
   check.positive(model.buoyancy_n, "hydrostatics.buoyancy_n");
@@ -308,13 +336,16 @@ void finalize_vehicle_model(VehicleModel& model) {
     check.fail("rigid_body.inertia_kg_m2",
                "the inertia tensor is not positive definite, so M_RB is not (no real body has it)");
   }
+}
 
-  // Hydrodynamics.
+void check_hydrodynamics(const ModelChecker& check, const VehicleModel& model) {
   check.non_positive(model.added_mass_derivatives, "hydrodynamics.added_mass_derivatives");
   check.non_positive(model.linear_damping, "hydrodynamics.linear_damping");
   check.non_positive(model.quadratic_damping, "hydrodynamics.quadratic_damping");
+}
 
-  // Thrusters: count, geometry, unit directions.
+/// Thrusters: count, geometry, unit directions (normalised), allocation B and its rank.
+void build_allocation(const ModelChecker& check, VehicleModel& model) {
   const int n = model.num_thrusters();
   if (n < 1 || n > kMaxThrusters) {
     check.fail("thrusters", "expected 1 to " + std::to_string(kMaxThrusters) + " thrusters, got " +
@@ -343,13 +374,13 @@ void finalize_vehicle_model(VehicleModel& model) {
                                 format_number(kAllocationMinSingularValue) +
                                 "); expected at least " + std::to_string(kMinControllableDof));
   }
+}
 
+void check_thruster_dynamics_and_integration(const ModelChecker& check, const VehicleModel& model) {
   const ThrusterDynamics& td = model.thruster_dynamics;
   check.positive(td.max_thrust_n, "thruster_dynamics.max_thrust_n");
   check.positive(td.lag_time_constant_s, "thruster_dynamics.lag_time_constant_s");
   check.positive(td.slew_rate_n_per_s, "thruster_dynamics.slew_rate_n_per_s");
-
-  // Integration and limits.
   check.positive(model.control_step_s, "integration.control_step_s");
   if (model.substeps < 1) {
     check.fail("integration.substeps", "expected >= 1, got " + std::to_string(model.substeps));
@@ -360,7 +391,10 @@ void finalize_vehicle_model(VehicleModel& model) {
   check.positive(model.blow_up.max_linear_speed_mps, "blow_up_limits.max_linear_speed_mps");
   check.positive(model.blow_up.max_angular_rate_rad_s, "blow_up_limits.max_angular_rate_rad_s");
   check.positive(model.blow_up.max_position_m, "blow_up_limits.max_position_m");
+}
 
+/// M_RB, M_A, M and its inverse; M must be symmetric positive definite.
+void build_mass_matrices(const ModelChecker& check, VehicleModel& model) {
   // M_RB, Fossen 2011 eq. 3.44: [m I, -m S(r_g); m S(r_g), I_b] with I_b = I_g - m S(r_g)^2
   // (eq. 3.37, parallel axes from the CG to the body origin).
   const double m = model.mass_kg;
@@ -369,7 +403,7 @@ void finalize_vehicle_model(VehicleModel& model) {
   model.mass_rigid_body.topLeftCorner<3, 3>() = m * Matrix3::Identity();
   model.mass_rigid_body.topRightCorner<3, 3>() = -m * s_rg;
   model.mass_rigid_body.bottomLeftCorner<3, 3>() = m * s_rg;
-  model.mass_rigid_body.bottomRightCorner<3, 3>() = inertia - m * s_rg * s_rg;
+  model.mass_rigid_body.bottomRightCorner<3, 3>() = model.inertia_kg_m2 - m * s_rg * s_rg;
   model.mass_added = (-model.added_mass_derivatives).asDiagonal();
   model.mass_total = model.mass_rigid_body + model.mass_added;
 
@@ -386,6 +420,31 @@ void finalize_vehicle_model(VehicleModel& model) {
   model.mass_total_inverse = llt.solve(Matrix6::Identity());
 }
 
+}  // namespace
+
+int allocation_rank(const AllocationMatrix& allocation) {
+  // Fixed sizes only (no heap, no dynamic GEMM kernels): zero columns pad B to 6 x kMax without
+  // changing its singular values, which are the square roots of the eigenvalues of B B^T.
+  Eigen::Matrix<double, 6, kMaxThrusters> padded = Eigen::Matrix<double, 6, kMaxThrusters>::Zero();
+  padded.leftCols(allocation.cols()) = allocation;
+  const Matrix6 gram = padded * padded.transpose();
+  const Eigen::SelfAdjointEigenSolver<Matrix6> eigen(gram, Eigen::EigenvaluesOnly);
+  int rank = 0;
+  for (int i = 0; i < 6; ++i) {
+    if (std::sqrt(std::max(eigen.eigenvalues()(i), 0.0)) >= kAllocationMinSingularValue) ++rank;
+  }
+  return rank;
+}
+
+void finalize_vehicle_model(VehicleModel& model) {
+  const ModelChecker check(model);
+  check_rigid_body(check, model);
+  check_hydrodynamics(check, model);
+  build_allocation(check, model);
+  check_thruster_dynamics_and_integration(check, model);
+  build_mass_matrices(check, model);
+}
+
 const config::Table<ThrusterDynamics>& thruster_dynamics_table() {
   static const config::Table<ThrusterDynamics> table = make_thruster_dynamics_table();
   return table;
@@ -396,108 +455,14 @@ const config::Table<BlowUpLimits>& blow_up_limits_table() {
   return table;
 }
 
+config::SectionDoc vehicle_file_doc() { return config::section_doc(vehicle_file_table()); }
+
 VehicleModel load_vehicle_file(const std::string& path) {
-  const FileReader in(path);
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw VehicleFileError(path, "(file)", "cannot open the file");
-  } catch (const YAML::ParserException& e) {
-    throw VehicleFileError(path, "(syntax)", e.what());
-  }
-
-  VehicleModel model;
-  model.source_file = path;
-  in.check_map(root, "",
-               {"name", "rigid_body", "hydrostatics", "hydrodynamics", "thrusters",
-                "thruster_dynamics", "integration", "blow_up_limits"});
-  model.name = in.text(root, "", "name");
-
-  const YAML::Node body = in.require(root, "", "rigid_body");
-  in.check_map(body, "rigid_body", {"mass_kg", "inertia_kg_m2", "cog_body_m"});
-  model.mass_kg = in.number(body, "rigid_body", "mass_kg");
-  model.inertia_kg_m2 = in.inertia(body, "rigid_body", "inertia_kg_m2");
-  model.cog_body_m = in.vector(body, "rigid_body", "cog_body_m", 3);
-
-  const YAML::Node statics = in.require(root, "", "hydrostatics");
-  in.check_map(
-      statics, "hydrostatics",
-      {"gravity_mps2", "cob_body_m", "buoyancy_n", "displaced_volume_m3", "water_density_kg_m3"});
-  const double gravity_mps2 = in.number(statics, "hydrostatics", "gravity_mps2");
-  if (!(gravity_mps2 > 0)) in.fail("hydrostatics.gravity_mps2", "expected a positive number");
-  model.weight_n = model.mass_kg * gravity_mps2;
-  model.cob_body_m = in.vector(statics, "hydrostatics", "cob_body_m", 3);
-  const bool has_buoyancy = statics["buoyancy_n"].IsDefined();
-  const bool has_volume =
-      statics["displaced_volume_m3"].IsDefined() || statics["water_density_kg_m3"].IsDefined();
-  if (has_buoyancy == has_volume) {
-    in.fail("hydrostatics.buoyancy_n",
-            "give either buoyancy_n or both displaced_volume_m3 and water_density_kg_m3");
-  }
-  if (has_buoyancy) {
-    model.buoyancy_n = in.number(statics, "hydrostatics", "buoyancy_n");
-  } else {
-    const double volume = in.number(statics, "hydrostatics", "displaced_volume_m3");
-    const double density = in.number(statics, "hydrostatics", "water_density_kg_m3");
-    if (!(volume > 0)) in.fail("hydrostatics.displaced_volume_m3", "expected a positive number");
-    if (!(density > 0)) in.fail("hydrostatics.water_density_kg_m3", "expected a positive number");
-    model.buoyancy_n = density * gravity_mps2 * volume;
-  }
-
-  const YAML::Node hydro = in.require(root, "", "hydrodynamics");
-  in.check_map(
-      hydro, "hydrodynamics",
-      {"added_mass_derivatives", "linear_damping", "quadratic_damping", "added_mass_coriolis"});
-  model.added_mass_derivatives = in.vector(hydro, "hydrodynamics", "added_mass_derivatives", 6);
-  model.linear_damping = in.vector(hydro, "hydrodynamics", "linear_damping", 6);
-  model.quadratic_damping = in.vector(hydro, "hydrodynamics", "quadratic_damping", 6);
-  model.added_mass_coriolis = in.boolean(hydro, "hydrodynamics", "added_mass_coriolis");
-
-  const YAML::Node thrusters = in.require(root, "", "thrusters");
-  if (!thrusters.IsSequence() || thrusters.size() == 0) {
-    in.fail("thrusters", "expected a non-empty list of thrusters", &thrusters);
-  }
-  if (thrusters.size() > static_cast<std::size_t>(kMaxThrusters)) {
-    in.fail("thrusters",
-            "expected at most " + std::to_string(kMaxThrusters) + " thrusters, got " +
-                std::to_string(thrusters.size()),
-            &thrusters);
-  }
-  for (std::size_t i = 0; i < thrusters.size(); ++i) {
-    const std::string field = "thrusters[" + std::to_string(i) + "]";
-    const YAML::Node t = thrusters[i];
-    in.check_map(t, field, {"name", "position_body_m", "direction_body"});
-    Thruster thruster;
-    thruster.name = in.text(t, field, "name");
-    thruster.position_body_m = in.vector(t, field, "position_body_m", 3);
-    thruster.direction_body = in.vector(t, field, "direction_body", 3);
-    model.thrusters.push_back(thruster);
-  }
-
-  read_block(path, in.require(root, "", "thruster_dynamics"), "thruster_dynamics",
-             thruster_dynamics_table(), model.thruster_dynamics);
-
-  const YAML::Node integration = in.require(root, "", "integration");
-  in.check_map(integration, "integration", {"control_step_s", "integrator", "substeps"});
-  model.control_step_s = in.number(integration, "integration", "control_step_s");
-  const std::string integrator = in.text(integration, "integration", "integrator");
-  if (integrator == "rk4") {
-    model.integrator = Integrator::kRk4;
-  } else if (integrator == "semi_implicit_euler") {
-    model.integrator = Integrator::kSemiImplicitEuler;
-  } else {
-    const YAML::Node node = integration["integrator"];
-    in.fail("integration.integrator",
-            "expected rk4 or semi_implicit_euler, got '" + integrator + "'", &node);
-  }
-  model.substeps = in.integer(integration, "integration", "substeps");
-
-  read_block(path, in.require(root, "", "blow_up_limits"), "blow_up_limits", blow_up_limits_table(),
-             model.blow_up);
-
-  finalize_vehicle_model(model);
-  return model;
+  VehicleFile file = read_vehicle_file(path, load_yaml(path));
+  file.model.source_file = path;
+  apply_hydrostatics(file);
+  finalize_vehicle_model(file.model);
+  return std::move(file.model);
 }
 
 }  // namespace auvrl::sim

@@ -10,6 +10,7 @@
 namespace auvrl::config {
 template <class T>
 class Table;
+struct SectionDoc;
 }  // namespace auvrl::config
 
 namespace auvrl::sim {
@@ -125,6 +126,8 @@ VehicleModel load_vehicle_file(const std::string& path);
 /// The keys of a vehicle file's thruster_dynamics: and blow_up_limits: blocks (all required).
 const config::Table<ThrusterDynamics>& thruster_dynamics_table();
 const config::Table<BlowUpLimits>& blow_up_limits_table();
+/// Every block and key of a vehicle file (one section of docs/configuration.md).
+config::SectionDoc vehicle_file_doc();
 
 /// Fills the derived members (allocation, mass matrices) and validates the whole model;
 /// throws VehicleFileError with model.source_file. Called by load_vehicle_file; public so

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
@@ -142,11 +143,66 @@ std::vector<std::vector<double>> Codec<std::vector<std::vector<double>>>::parse(
   return out;
 }
 
+std::string show_numbers(const double* values, int n) {
+  return join(std::vector<double>(values, values + n));
+}
+
+void parse_numbers(const std::string& text, double* out, int n) {
+  const std::string expected = fmt::format("{} numbers such as 1,2,3 or [1, 2, 3]", n);
+  const YAML::Node list = parse_list(text, expected.c_str());
+  if (static_cast<int>(list.size()) != n) bad(text, expected.c_str());
+  for (int i = 0; i < n; ++i) {
+    if (!list[i].IsScalar()) bad(text, expected.c_str());
+    out[i] = parse_number(list[i].Scalar());
+  }
+}
+
+std::string show_square(const double* values, int n) {
+  bool diagonal = true;
+  for (int c = 0; c < n; ++c) {
+    for (int r = 0; r < n; ++r) diagonal = diagonal && (r == c || values[c * n + r] == 0.0);
+  }
+  std::vector<double> row(static_cast<std::size_t>(n));
+  if (diagonal) {
+    for (int i = 0; i < n; ++i) row[static_cast<std::size_t>(i)] = values[i * n + i];
+    return join(row);
+  }
+  std::string out = "[";
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < n; ++c) row[static_cast<std::size_t>(c)] = values[c * n + r];
+    out += (r > 0 ? ", " : "") + join(row);
+  }
+  return out + "]";
+}
+
+void parse_square(const std::string& text, double* out, int n) {
+  const std::string expected =
+      fmt::format("{0} rows of {0} numbers or the {0} numbers of the diagonal", n);
+  const YAML::Node list = parse_list(text, expected.c_str());
+  if (static_cast<int>(list.size()) != n) bad(text, expected.c_str());
+  std::fill(out, out + n * n, 0.0);
+  const bool diagonal = list[0].IsScalar();
+  for (int r = 0; r < n; ++r) {
+    if (diagonal) {
+      if (!list[r].IsScalar()) bad(text, expected.c_str());
+      out[r * n + r] = parse_number(list[r].Scalar());
+      continue;
+    }
+    if (!list[r].IsSequence() || static_cast<int>(list[r].size()) != n) bad(text, expected.c_str());
+    for (int c = 0; c < n; ++c) {
+      if (!list[r][c].IsScalar()) bad(text, expected.c_str());
+      out[c * n + r] = parse_number(list[r][c].Scalar());
+    }
+  }
+}
+
 std::string flag_name(const std::string& key) {
   std::string out = key;
   for (char& c : out) c = (c == '_' || c == '.') ? '-' : c;
   return out;
 }
+
+double shown_number(const std::string& text) { return std::strtod(text.c_str(), nullptr); }
 
 std::string format_range(double lo, double hi) {
   if (std::isinf(hi)) return fmt::format(">= {}", lo);
@@ -160,9 +216,11 @@ std::string render_markdown(const std::vector<SectionDoc>& sections, const std::
     out += fmt::format("\n## `{}`\n\n{}\n\n", s.name, s.doc);
     out += "| key | type | default | unit / range | doc |\n|---|---|---|---|---|\n";
     for (const FieldDoc& r : s.rows) {
-      out += fmt::format("| `{}` | {} | `{}` | {} | {} |\n", r.key, escape(r.type),
-                         r.default_text.empty() ? std::string("\"\"") : escape(r.default_text),
-                         escape(r.unit), escape(r.doc));
+      const std::string value =
+          r.default_text.empty() ? std::string("\"\"") : escape(r.default_text);
+      out += fmt::format("| `{}` | {} | {} | {} | {} |\n", r.key, escape(r.type),
+                         r.required ? std::string("required") : "`" + value + "`", escape(r.unit),
+                         escape(r.doc));
     }
   }
   return out;

@@ -46,6 +46,47 @@ AUVRL_CONFIG_CODEC(Eigen::Vector3d, "[x, y, z]");
 AUVRL_CONFIG_CODEC(std::vector<std::vector<double>>, "list of lists of numbers");
 #undef AUVRL_CONFIG_CODEC
 
+/// A number as show() wrote it, back (strtod: never throws, even on a denormal).
+double shown_number(const std::string& text);
+
+/// "[1, 2, 3]" (shortest round-trip numbers).
+std::string show_numbers(const double* values, int n);
+/// Exactly n numbers ("1,2,3" or "[1, 2, 3]"); throws std::invalid_argument.
+void parse_numbers(const std::string& text, double* out, int n);
+/// An n x n column-major matrix as its diagonal "[a, b, c]" when the rest is zero, else rows.
+std::string show_square(const double* values, int n);
+/// n rows of n numbers or the n numbers of the diagonal; throws std::invalid_argument.
+void parse_square(const std::string& text, double* out, int n);
+
+/// A fixed-size vector of N numbers (Eigen::Vector3d has its own "[x, y, z]" above).
+template <int N>
+struct Codec<Eigen::Matrix<double, N, 1>> {
+  static std::string type() { return "list of " + std::to_string(N) + " numbers"; }
+  static std::string show(const Eigen::Matrix<double, N, 1>& v) {
+    return show_numbers(v.data(), N);
+  }
+  static Eigen::Matrix<double, N, 1> parse(const std::string& text) {
+    Eigen::Matrix<double, N, 1> v;
+    parse_numbers(text, v.data(), N);
+    return v;
+  }
+};
+
+/// An N x N matrix: N rows of N numbers, or its diagonal as N numbers.
+template <int N>
+struct Codec<Eigen::Matrix<double, N, N>> {
+  static std::string type() {
+    const std::string n = std::to_string(N);
+    return n + "x" + n + " matrix: " + n + " rows, or the diagonal alone";
+  }
+  static std::string show(const Eigen::Matrix<double, N, N>& m) { return show_square(m.data(), N); }
+  static Eigen::Matrix<double, N, N> parse(const std::string& text) {
+    Eigen::Matrix<double, N, N> m;
+    parse_square(text, m.data(), N);
+    return m;
+  }
+};
+
 /// One row of the generated documentation.
 struct FieldDoc {
   std::string key;  ///< dotted within its section ("scales.position_m")
@@ -53,6 +94,7 @@ struct FieldDoc {
   std::string default_text;
   std::string unit;  ///< unit and/or allowed range
   std::string doc;
+  bool required = false;  ///< no default: the key must be given
 };
 
 /// The command-line flag of a key: `replay_capacity` -> `replay-capacity`, `scales.depth_m` ->
@@ -71,7 +113,9 @@ struct Field {
   std::function<std::string(T&)> show;
   /// An error message when the value is out of range; empty when it is fine.
   std::function<std::string(T&)> check;
-  std::vector<Field<T>> children;  ///< a sub-map (task.scales): its keys, prefixed
+  /// A sub-map (task.scales) or the entries of a list of maps (thrusters[].name): its keys,
+  /// prefixed. Entries of a list have no parse (they get no flag).
+  std::vector<Field<T>> children;
 };
 
 /// The settings of a configuration struct T, in the order they are documented.
@@ -154,16 +198,38 @@ class Table {
     f.unit = f.unit.empty() ? text : f.unit + ", " + text;
     auto show = f.show;
     f.check = [show, text, lo, hi](T& t) {
-      const double v = std::stod(show(t));
+      const double v = shown_number(show(t));
       return v >= lo && v <= hi ? std::string() : "expected " + text + ", got " + show(t);
     };
+    return *this;
+  }
+
+  /// The last field must be > 0 (a step, a mass); checked on reading a file and on a flag.
+  Table& positive() {
+    Field<T>& f = fields_.back();
+    f.unit = f.unit.empty() ? "> 0" : f.unit + ", > 0";
+    auto show = f.show;
+    f.check = [show](T& t) {
+      return shown_number(show(t)) > 0 ? std::string() : "expected > 0, got " + show(t);
+    };
+    return *this;
+  }
+
+  /// A check across fields, run once all are read: fn(section, target) calls section.fail(key,
+  /// what) on a bad combination (e.g. keys that exclude each other).
+  Table& validate(std::function<void(const Section&, T&)> fn) {
+    validators_.push_back(std::move(fn));
     return *this;
   }
 
   /// Every field of another table, at this level (a struct inside T whose keys share T's map).
   template <class U, class Access>
   Table& include(const Table<U>& other, Access access) {
-    for (const Field<U>& f : other.fields()) fields_.push_back(lift(f, accessor(access), ""));
+    auto get = accessor(access);
+    for (const Field<U>& f : other.fields()) fields_.push_back(lift(f, get, ""));
+    for (const auto& v : other.validators()) {
+      validators_.push_back([v, get](const Section& s, T& t) { v(s, get(t)); });
+    }
     return *this;
   }
 
@@ -174,6 +240,29 @@ class Table {
     Field<T> group = base(key, "map", "", other.doc());
     group.read = [key, other, get](Section& s, T& t) { other.read(s.child(key), get(t)); };
     for (const Field<U>& f : other.fields()) group.children.push_back(lift(f, get, key + "."));
+    fields_.push_back(std::move(group));
+    return *this;
+  }
+
+  /// A list of maps under key, each entry read by other into a U (a fresh U{} each) and the
+  /// list stored through access (T& -> std::vector<U>&); it must have min_items..max_items
+  /// entries. Documented as key[].sub; its keys get no flags.
+  template <class U, class Access>
+  Table& list(const std::string& key, const Table<U>& other, Access access,
+              std::size_t min_items = 0,
+              std::size_t max_items = std::numeric_limits<std::size_t>::max()) {
+    auto get = accessor(access);
+    Field<T> group = base(key, "list of maps", "", other.doc());
+    group.read = [key, other, get, min_items, max_items](Section& s, T& t) {
+      std::vector<U> entries;
+      for (Section& item : s.items(key, min_items, max_items)) {
+        U entry{};
+        other.read(item, entry);
+        entries.push_back(std::move(entry));
+      }
+      if (s.has(key)) get(t) = std::move(entries);
+    };
+    for (const Field<U>& f : other.fields()) group.children.push_back(entry(f, key + "[]."));
     fields_.push_back(std::move(group));
     return *this;
   }
@@ -189,6 +278,7 @@ class Table {
         if (!error.empty()) section.fail(f.key, error);
       }
     }
+    for (const auto& validate : validators_) validate(section, target);
   }
 
   /// Reads the section into target and rejects unknown keys.
@@ -203,7 +293,7 @@ class Table {
   template <class CommandLineT>
   void add_flags(CommandLineT& cmd, T& target, const std::set<std::string>& skip = {}) const {
     for (const Field<T>& f : flat()) {
-      if (skip.count(f.key) != 0) continue;
+      if (skip.count(f.key) != 0 || !f.parse) continue;
       const std::string help = f.unit.empty() ? f.doc : f.doc + " [" + f.unit + "]";
       if (f.is_bool) {
         cmd.custom_flag(
@@ -238,13 +328,16 @@ class Table {
     T defaults{};
     std::vector<FieldDoc> rows;
     for (const Field<T>& f : flat())
-      rows.push_back({f.key, f.type, f.show(defaults), f.unit, f.doc});
+      rows.push_back({f.key, f.type, f.show(defaults), f.unit, f.doc, f.required});
     return rows;
   }
 
   const std::string& name() const { return name_; }
   const std::string& doc() const { return doc_; }
   const std::vector<Field<T>>& fields() const { return fields_; }
+  const std::vector<std::function<void(const Section&, T&)>>& validators() const {
+    return validators_;
+  }
 
  private:
   template <class Access>
@@ -271,22 +364,38 @@ class Table {
   static Field<T> lift(const Field<U>& f, Get get, const std::string& prefix) {
     Field<T> out = base(prefix + f.key, f.type, f.unit, f.doc);
     out.is_bool = f.is_bool;
+    out.required = f.required;
     if (f.read) out.read = [r = f.read, get](Section& s, T& t) { r(s, get(t)); };
-    out.parse = [p = f.parse, get](const std::string& text, T& t) { p(text, get(t)); };
+    if (f.parse) out.parse = [p = f.parse, get](const std::string& text, T& t) { p(text, get(t)); };
     out.show = [s = f.show, get](T& t) { return s(get(t)); };
     if (f.check) out.check = [c = f.check, get](T& t) { return c(get(t)); };
     for (const Field<U>& child : f.children) out.children.push_back(lift(child, get, prefix));
     return out;
   }
 
-  /// Fields with sub-maps expanded into their keys.
-  std::vector<Field<T>> flat() const {
+  /// A field of a list entry (U) for the docs: shown from a default U, never read or parsed.
+  template <class U>
+  static Field<T> entry(const Field<U>& f, const std::string& prefix) {
+    Field<T> out = base(prefix + f.key, f.type, f.unit, f.doc);
+    out.required = f.required;
+    out.show = [s = f.show](T&) {
+      U defaults{};
+      return s(defaults);
+    };
+    for (const Field<U>& child : f.children) out.children.push_back(entry(child, prefix));
+    return out;
+  }
+
+  /// Fields with sub-maps and lists expanded into their keys, at any depth.
+  std::vector<Field<T>> flat() const { return flatten(fields_); }
+  static std::vector<Field<T>> flatten(const std::vector<Field<T>>& fields) {
     std::vector<Field<T>> out;
-    for (const Field<T>& f : fields_) {
+    for (const Field<T>& f : fields) {
       if (f.children.empty()) {
         out.push_back(f);
       } else {
-        out.insert(out.end(), f.children.begin(), f.children.end());
+        const std::vector<Field<T>> inner = flatten(f.children);
+        out.insert(out.end(), inner.begin(), inner.end());
       }
     }
     return out;
@@ -297,6 +406,7 @@ class Table {
   std::string name_;
   std::string doc_;
   std::vector<Field<T>> fields_;
+  std::vector<std::function<void(const Section&, T&)>> validators_;
 };
 
 /// ">= lo", "<= hi" or "lo..hi" (shortest round-trip numbers).

@@ -1,5 +1,8 @@
 #include "common/config/yaml_config.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -23,8 +26,13 @@ std::string Section::key_path(const std::string& key) const {
 void Section::fail(const std::string& key, const std::string& what) const {
   std::string where;
   const YAML::Node n = node_.IsMap() ? node_[key] : YAML::Node();
-  if (n.IsDefined() && n.Mark().line >= 0)
+  if (n.IsDefined() && n.Mark().line >= 0) {
     where = " (line " + std::to_string(n.Mark().line + 1) + ")";
+  } else if (!path_.empty() && node_.IsMap() && node_.Mark().line >= 0) {
+    // An absent key: point at the block it belongs in.
+    where = " (in the block '" + path_ + "' starting at line " +
+            std::to_string(node_.Mark().line + 1) + ")";
+  }
   throw ConfigError(file_ + ": '" + key_path(key) + "': " + what + where, key_path(key),
                     what + where);
 }
@@ -139,11 +147,36 @@ void Section::read(const std::string& key, std::vector<int>& value) {
   }
 }
 
-void Section::read(const std::string& key, Eigen::Vector3d& value) {
+void Section::read_numbers(const std::string& key, double* out, int n) {
   if (const auto found = get(key)) {
-    const YAML::Node& n = *found;
-    if (!n.IsSequence() || n.size() != 3) fail(key, "expected a list of 3 numbers");
-    for (int i = 0; i < 3; ++i) value[i] = number(n[i], key);
+    const YAML::Node& node = *found;
+    if (!node.IsSequence() || static_cast<int>(node.size()) != n) {
+      fail(key, fmt::format("expected a list of {} numbers{}", n,
+                            node.IsSequence() ? fmt::format(", got {}", node.size()) : ""));
+    }
+    for (int i = 0; i < n; ++i) out[i] = number(node[i], key);
+  }
+}
+
+void Section::read_square(const std::string& key, double* out, int n) {
+  if (const auto found = get(key)) {
+    const YAML::Node& node = *found;
+    const std::string expected =
+        fmt::format("expected {0} rows of {0} numbers, or the {0} numbers of the diagonal", n);
+    if (!node.IsSequence() || static_cast<int>(node.size()) != n) fail(key, expected);
+    std::fill(out, out + n * n, 0.0);
+    if (node[0].IsScalar()) {
+      for (int i = 0; i < n; ++i) {
+        if (!node[i].IsScalar()) fail(key, expected);
+        out[i * n + i] = number(node[i], key);
+      }
+      return;
+    }
+    for (int r = 0; r < n; ++r) {
+      const YAML::Node row = node[r];
+      if (!row.IsSequence() || static_cast<int>(row.size()) != n) fail(key, expected);
+      for (int c = 0; c < n; ++c) out[c * n + r] = number(row[c], key);
+    }
   }
 }
 
@@ -167,6 +200,26 @@ Section Section::child(const std::string& key) {
   return Section(file_, key_path(key), found ? *found : YAML::Node());
 }
 
+std::vector<Section> Section::items(const std::string& key, std::size_t min_items,
+                                    std::size_t max_items) {
+  std::vector<Section> out;
+  const auto found = get(key);
+  if (!found) return out;
+  const YAML::Node& node = *found;
+  if (!node.IsSequence()) fail(key, "expected a list of maps");
+  if (node.size() < min_items) {
+    fail(key, fmt::format("expected at least {} {}, got {}", min_items,
+                          min_items == 1 ? "entry" : "entries", node.size()));
+  }
+  if (node.size() > max_items) {
+    fail(key, fmt::format("expected at most {} entries, got {}", max_items, node.size()));
+  }
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    out.emplace_back(file_, fmt::format("{}[{}]", key_path(key), i), node[i]);
+  }
+  return out;
+}
+
 void Section::ignore(std::initializer_list<const char*> keys) {
   for (const char* k : keys) read_.insert(k);
 }
@@ -176,9 +229,11 @@ void Section::finish() const {
   for (const auto& entry : node_) {
     // A complex key ("? [a, b]: ...") is valid YAML but no name (found by fuzz_run_config).
     if (!entry.first.IsScalar()) {
-      throw ConfigError(file_ + ": '" + (path_.empty() ? std::string("top level") : path_) +
-                        "': expected names as keys (line " +
-                        std::to_string(entry.first.Mark().line + 1) + ")");
+      const std::string detail =
+          "expected names as keys (line " + std::to_string(entry.first.Mark().line + 1) + ")";
+      throw ConfigError(
+          file_ + ": '" + (path_.empty() ? std::string("top level") : path_) + "': " + detail,
+          path_, detail);
     }
     const std::string key = entry.first.Scalar();
     if (read_.count(key) == 0) {

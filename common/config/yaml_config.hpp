@@ -46,17 +46,33 @@ class Section {
   void read(const std::string& key, bool& value);
   void read(const std::string& key, std::string& value);
   void read(const std::string& key, std::vector<int>& value);
-  void read(const std::string& key, Eigen::Vector3d& value);
+  /// A list of exactly N numbers (Eigen::Vector3d: [x, y, z]).
+  template <int N>
+  void read(const std::string& key, Eigen::Matrix<double, N, 1>& value) {
+    read_numbers(key, value.data(), N);
+  }
+  /// An N x N matrix: N rows of N numbers, or N numbers for its diagonal (the rest zero).
+  template <int N>
+  void read(const std::string& key, Eigen::Matrix<double, N, N>& value) {
+    static_assert(N > 1, "a 1x1 matrix is a number");
+    read_square(key, value.data(), N);
+  }
   /// A list of lists of numbers (e.g. schedule knots [[episode, beta], ...]).
   void read(const std::string& key, std::vector<std::vector<double>>& value);
   /// A sub-map (empty when absent).
   Section child(const std::string& key);
+  /// A list of maps, one Section per entry (paths "key[0]", "key[1]", ...; none when absent);
+  /// fails unless it has min_items..max_items entries (checked before any entry is read).
+  std::vector<Section> items(const std::string& key, std::size_t min_items = 0,
+                             std::size_t max_items = static_cast<std::size_t>(-1));
   /// Marks keys as known without reading them (sections other processes read).
   void ignore(std::initializer_list<const char*> keys);
   void ignore_key(const std::string& key) { read_.insert(key); }
-  /// Throws ConfigError for any key nobody read.
+  /// Throws ConfigError for any key nobody read (or a key that is no name: "? [a, b]").
   void finish() const;
 
+  /// Throws ConfigError naming file, dotted key and line (of the key's value; of the map
+  /// itself when the key is absent).
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
   const std::string& file() const { return file_; }
   std::string key_path(const std::string& key) const;
@@ -64,6 +80,9 @@ class Section {
  private:
   std::optional<YAML::Node> get(const std::string& key);
   double number(const YAML::Node& node, const std::string& key) const;
+  void read_numbers(const std::string& key, double* out, int n);
+  /// Column-major n x n (Eigen's layout).
+  void read_square(const std::string& key, double* out, int n);
   std::int64_t integer(const YAML::Node& node, const std::string& key) const;
 
   std::string file_;

@@ -197,4 +197,126 @@ TEST(ConfigTable, DocsHaveEveryKeyWithItsDefault) {
       << md;
 }
 
+// ---- Fixed-size vectors, square matrices, lists of maps, positive(), validate(). ----------
+
+struct Leg {
+  std::string name;
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();
+};
+
+struct Body {
+  Eigen::Matrix<double, 4, 1> gains = Eigen::Matrix<double, 4, 1>::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity();
+  double mass = 1.0;
+  double a = 0, b = 0;
+  std::vector<Leg> legs;
+};
+
+config::Table<Body> make_body_table() {
+  config::Table<Leg> leg("legs", "a leg");
+  leg.field("name", &Leg::name, "", "label").required();
+  leg.field("at", &Leg::at, "m", "where");
+  config::Table<Body> t("body", "a body");
+  t.field("gains", &Body::gains, "", "four gains");
+  t.field("inertia", &Body::inertia, "kg m^2", "inertia");
+  t.field("mass", &Body::mass, "kg", "mass").positive();
+  t.field("a", &Body::a, "", "a (or b)");
+  t.field("b", &Body::b, "", "b (or a)");
+  t.validate([](const config::Section& s, Body&) {
+    if (s.has("a") && s.has("b")) s.fail("a", "give a or b, not both");
+  });
+  t.list("legs", leg, &Body::legs, 1, 2).required();
+  return t;
+}
+
+std::string read_body_error(const std::string& text) {
+  Body b;
+  try {
+    make_body_table().read(load(text).child("body"), b);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ConfigTable, ReadsVectorsMatricesAndListsOfMaps) {
+  Body b;
+  make_body_table().read(load("body:\n  gains: [1, 2, 3, 4]\n  inertia: [[2, 0.5, 0], [0.5, 3, 0],"
+                              " [0, 0, 4]]\n  legs:\n    - name: l\n      at: [1, 0, 0]\n"
+                              "    - name: r\n")
+                             .child("body"),
+                         b);
+  EXPECT_EQ(b.gains, Eigen::Vector4d(1, 2, 3, 4));
+  EXPECT_EQ(b.inertia(0, 1), 0.5);
+  EXPECT_EQ(b.inertia(1, 0), 0.5);
+  EXPECT_EQ(b.inertia(2, 2), 4.0);
+  ASSERT_EQ(b.legs.size(), 2u);
+  EXPECT_EQ(b.legs[0].at, Eigen::Vector3d(1, 0, 0));
+  EXPECT_EQ(b.legs[1].name, "r");
+  EXPECT_EQ(b.legs[1].at, Eigen::Vector3d::Zero());
+  // A square matrix may be written as its diagonal.
+  make_body_table().read(load("body:\n  inertia: [5, 6, 7]\n  legs: [{name: x}]\n").child("body"),
+                         b);
+  EXPECT_EQ(b.inertia, Eigen::Matrix3d(Eigen::Vector3d(5, 6, 7).asDiagonal()));
+}
+
+TEST(ConfigTable, VectorMatrixAndListErrorsNameKeyAndLine) {
+  const std::string legs = "  legs: [{name: x}]\n";
+  EXPECT_NE(read_body_error("body:\n  gains: [1, 2, 3]\n" + legs)
+                .find("'body.gains': expected a list of 4 numbers, got 3 (line 2)"),
+            std::string::npos);
+  EXPECT_NE(read_body_error("body:\n  inertia: [[1, 0], [0, 1], [0, 0]]\n" + legs)
+                .find("'body.inertia': expected 3 rows of 3 numbers"),
+            std::string::npos);
+  const std::string entry =
+      read_body_error("body:\n  legs:\n    - name: x\n    - name: y\n      nam: z\n");
+  EXPECT_NE(entry.find("'body.legs[1].nam': unknown key (line 5"), std::string::npos) << entry;
+  const std::string missing = read_body_error("body:\n  legs:\n    - at: [0, 0, 1]\n");
+  EXPECT_NE(missing.find("'body.legs[0].name': missing (in the block 'body.legs[0]' starting at"
+                         " line 3)"),
+            std::string::npos)
+      << missing;
+  EXPECT_NE(read_body_error("body:\n  legs: []\n").find("expected at least 1 entry, got 0"),
+            std::string::npos);
+  EXPECT_NE(read_body_error("body:\n  legs: [{name: a}, {name: b}, {name: c}]\n")
+                .find("'body.legs': expected at most 2 entries, got 3 (line 2)"),
+            std::string::npos);
+  EXPECT_NE(read_body_error("body:\n  legs: [1, 2]\n").find("'body.legs[0]' must be a map"),
+            std::string::npos);
+  EXPECT_NE(read_body_error("body:\n  mass: 1\n").find("'body.legs': missing"), std::string::npos);
+}
+
+TEST(ConfigTable, PositiveAndValidate) {
+  const std::string legs = "  legs: [{name: x}]\n";
+  EXPECT_NE(read_body_error("body:\n  mass: 0\n" + legs)
+                .find("'body.mass': expected > 0, got 0 (line 2)"),
+            std::string::npos);
+  EXPECT_EQ(read_body_error("body:\n  a: 1\n" + legs), "");
+  EXPECT_NE(read_body_error("body:\n  a: 1\n  b: 2\n" + legs)
+                .find("'body.a': give a or b, not both (line 2)"),
+            std::string::npos);
+}
+
+TEST(ConfigTable, ListEntriesAreDocumentedButGetNoFlags) {
+  const auto rows = make_body_table().docs();
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_EQ(rows[1].type, "3x3 matrix: 3 rows, or the diagonal alone");
+  EXPECT_EQ(rows[1].default_text, "[1, 1, 1]");
+  EXPECT_EQ(rows[2].unit, "kg, > 0");
+  EXPECT_EQ(rows[5].key, "legs[].name");
+  EXPECT_TRUE(rows[5].required);
+  EXPECT_EQ(rows[6].default_text, "[0, 0, 0]");
+  const std::string md = config::render_markdown({config::section_doc(make_body_table())}, "");
+  EXPECT_NE(md.find("| `legs[].name` | string | required |  | label |"), std::string::npos) << md;
+  Body b;
+  cli::CommandLine cmd("prog", "test");
+  make_body_table().add_flags(cmd, b);
+  const std::string help = cmd.usage();
+  EXPECT_EQ(help.find("--legs"), std::string::npos) << help;
+  ASSERT_TRUE(parse(cmd, {"--gains", "1,2,3,4", "--inertia", "[[1, 0, 0], [0, 2, 0], [0, 0, 3]]"}));
+  EXPECT_EQ(b.gains, Eigen::Vector4d(1, 2, 3, 4));
+  EXPECT_EQ(b.inertia(1, 1), 2.0);
+  EXPECT_THROW(parse(cmd, {"--gains", "1,2"}), cli::UsageError);
+}
+
 }  // namespace
