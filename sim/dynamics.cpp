@@ -269,7 +269,7 @@ AUVRL_HOT void motion_rates(const Plant& pl, const double* x, double* dx) {
   accelerate(pl, r, x + kNu, dx + kNu);
 }
 
-void rk4_substep(const Plant& pl, Motion& x, double h) {
+AUVRL_HOT void rk4_substep(const Plant& pl, Motion& x, double h) {
   Motion k1, k2, k3, k4, stage;
   motion_rates(pl, x, k1);
   for (int i = 0; i < kStateSize; ++i) stage[i] = x[i] + 0.5 * h * k1[i];
