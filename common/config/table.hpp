@@ -169,7 +169,7 @@ class Table {
                     const std::string& type, const std::string& unit, const std::string& doc) {
     auto get = accessor(access);
     Field<T> f = base(key, type, unit, doc);
-    f.read = [get, key, parse, show](Section& s, T& t) {
+    f.read = [get, key, parse](Section& s, T& t) {
       if (!s.has(key)) return s.ignore_key(key);
       std::string text;
       s.read(key, text);
