@@ -22,6 +22,79 @@ std::vector<std::string> parse_peer_list(const std::string& text) {
   }
 }
 
+void add_transport_options(cli::CommandLine& cmd, TransportConfig& config,
+                           std::vector<std::string>* given) {
+  const auto record = [given](const std::string& name, const std::string& value) {
+    if (given == nullptr) return;
+    given->push_back("--" + name);
+    if (!value.empty()) given->push_back(value);
+  };
+  cmd.custom_option(
+      "transport",
+      [&config, record](const std::string& v) {
+        config.kind = parse_transport_kind(v);
+        record("transport", v);
+      },
+      to_string(config.kind), "lcm (UDP multicast) or dds (Cyclone DDS, unicast discovery)");
+  cmd.custom_option(
+      "lcm-url",
+      [&config, record](const std::string& v) {
+        config.lcm_url = v;
+        record("lcm-url", v);
+      },
+      config.lcm_url, "LCM URL of the system's bus (--transport lcm)");
+  cmd.custom_option(
+      "dds-domain",
+      [&config, record](const std::string& v) {
+        std::size_t used = 0;
+        const int domain = std::stoi(v, &used);
+        if (used != v.size()) throw TransportError("expected an integer, got '" + v + "'");
+        config.dds.domain_id = domain;
+        record("dds-domain", v);
+      },
+      std::to_string(config.dds.domain_id), "DDS domain id, 0..232 (--transport dds)");
+  cmd.custom_option(
+      "dds-peers",
+      [&config, record](const std::string& v) {
+        config.dds.peers = parse_peer_list(v);
+        record("dds-peers", v);
+      },
+      "127.0.0.1",
+      "hosts of the other DDS participants, comma-separated (unicast discovery; anything but "
+      "loopback needs --allow-off-host)");
+  cmd.custom_option(
+      "dds-config",
+      [&config, record](const std::string& v) {
+        config.dds.config_path = v;
+        record("dds-config", v);
+      },
+      "", "a Cyclone XML file replacing the generated configuration (needs --allow-off-host)");
+  cmd.custom_flag(
+      "dds-lockstep-best-effort",
+      [&config, record] {
+        config.dds.lockstep_reliable = false;
+        record("dds-lockstep-best-effort", "");
+      },
+      "DDS: lockstep commands and states best effort instead of reliable (every process of "
+      "a lockstep pair must agree)");
+  cmd.custom_flag(
+      "allow-off-host",
+      [&config, record] {
+        config.allow_off_host = true;
+        record("allow-off-host", "");
+      },
+      "accept a transport whose traffic can leave this host (LCM URL with ttl > 0, DDS peers "
+      "off this host or a DDS configuration file; no authentication!)");
+}
+
+void add_lockstep_options(cli::CommandLine& cmd, LockstepBusOptions& options) {
+  cmd.option("lockstep-lcm-url", &options.lcm_url,
+             "LCM: a bus of its own for the lockstep commands and states (default: the "
+             "system's bus)");
+  cmd.option("lockstep-dds-domain", &options.dds_domain_id,
+             "DDS: a domain of its own for the lockstep commands and states (-1: the system's)");
+}
+
 std::optional<TransportConfig> lockstep_bus_config(const TransportConfig& system,
                                                    const LockstepBusOptions& options) {
   TransportConfig bus = system;

@@ -40,11 +40,11 @@ int run_eval(int argc, const char* const* argv) {
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
   cli.option("seed", &seed, "seed of the suite's way-points and the vehicle resets");
+  cli.check("seed", auvrl::cli::at_least(0));
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
   cli.option("suite-trajectories", &request.suite_trajectories,
              "trajectory files for the first N suite episodes (-1: all)");
   if (!cli.parse(argc, argv)) return 0;
-  if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
   request.seed = static_cast<std::uint64_t>(seed);
   auvrl::eval::run_eval_request(request, std::cout);
   return 0;
@@ -74,8 +74,8 @@ int run_fastest(int argc, const char* const* argv) {
              "count an arrival only if the vehicle then stays within this many metres for 3 s "
              "(default: arriving is enough)");
   cli.option("seed", &seed, "seed of the search's draws");
+  cli.check("seed", auvrl::cli::at_least(0));
   if (!cli.parse(argc, argv)) return 0;
-  if (seed < 0) throw auvrl::cli::UsageError("option --seed: expected a value >= 0");
   request.search.seed = static_cast<std::uint64_t>(seed);
   auvrl::tools::run_arrival_search_request(request, std::cout);
   return 0;
@@ -115,13 +115,11 @@ int run_train(int argc, const char* const* argv) {
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
   cli.option("network", &network,
              "private (default: own network namespace) or host (LCM on the host's network)");
+  cli.choices("network", {"private", "host"});
   // Over the configuration's transport: section; recorded and passed to every process.
   auvrl::transport::TransportConfig cli_transport;
   auvrl::transport::add_transport_options(cli, cli_transport, &options.transport_args);
   if (!cli.parse(argc, argv)) return 0;
-  if (network != "private" && network != "host") {
-    throw auvrl::cli::UsageError("option --network: expected private or host");
-  }
   options.evaluate = !no_eval;
   if (!resume_dir.empty()) {
     options.resume = true;
