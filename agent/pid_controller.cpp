@@ -69,15 +69,14 @@ PidController::PidController(const sim::VehicleModel& model, PidGains gains)
   mass_eff_ = model.mass_total.diagonal();
   drag_quad_ = model.quadratic_damping.cwiseAbs();
 
-  // The roll row of Nessie VII's allocation is almost zero (lateral thrusters 5 cm off the
-  // roll axis, a row norm under the model's kAllocationMinSingularValue): inverting it would
-  // ask the lateral thrusters for hundreds of newtons to make a roll moment the restoring
-  // moment provides anyway. Rows with less authority than that threshold are dropped; the
-  // pseudo-inverse of the rest (a complete orthogonal decomposition, once) is the
-  // minimum-norm thrust for the controllable DOF.
+  // Only the DOF the thrusters drive independently (the model's controlled_axes) are asked
+  // for: Nessie VII's roll row is almost zero (lateral thrusters 5 cm off the roll axis);
+  // inverting it would ask for hundreds of newtons to make a roll moment the restoring moment
+  // provides anyway. The other rows are dropped; the pseudo-inverse of the rest (a complete
+  // orthogonal decomposition, once) is the minimum-norm thrust for the controlled DOF.
   Eigen::MatrixXd b = model.allocation;
   for (Eigen::Index row = 0; row < 6; ++row) {
-    if (b.row(row).norm() < sim::kAllocationMinSingularValue) b.row(row).setZero();
+    if (!model.controlled_axes[static_cast<std::size_t>(row)]) b.row(row).setZero();
   }
   pinv_ = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(b).pseudoInverse();
   // Every DOF the controller drives must be reachable: B pinv must reproduce it.
@@ -86,9 +85,9 @@ PidController::PidController(const sim::VehicleModel& model, PidGains gains)
     Eigen::Matrix<double, 6, 1> unit = Eigen::Matrix<double, 6, 1>::Zero();
     unit[axis] = 1.0;
     if ((reproduced * unit - unit).norm() > 1e-9) {
-      static const char* kNames[6] = {"surge", "sway", "heave", "roll", "pitch", "yaw"};
       throw std::invalid_argument("PID controller: vehicle model '" + model.name +
-                                  "' has no independent control authority in " + kNames[axis]);
+                                  "' has no independent control authority in " +
+                                  sim::kAxisNames[axis]);
     }
   }
   reset();

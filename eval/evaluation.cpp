@@ -159,12 +159,6 @@ std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config,
   return {};
 }
 
-void apply_vehicle(const sim::VehicleModel& model, task::TaskConfig& task) {
-  task.num_thrusters = model.num_thrusters();
-  task.max_thrust_n = model.thruster_dynamics.max_thrust_n;
-  task.control_step_s = model.control_step_s;
-}
-
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
                                   agent::Controller& controller, const EvaluationEpisode& episode,
                                   std::vector<agent::TrajectoryRow>* trajectory) {
@@ -210,7 +204,7 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
                                        agent::Controller& controller,
                                        const std::vector<Scenario>& scenarios,
                                        const std::string& out_dir) {
-  apply_vehicle(model, config.task);
+  task::apply_vehicle(model.facts(), config.task);
   config.task.max_steps = config.episode_steps;  // checked here; each episode applies it
   config.task.validate();
   if (!(config.reach_radius_m > 0)) {

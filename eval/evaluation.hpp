@@ -98,10 +98,6 @@ struct SummaryRow {
 /// Name of an end reason as written in summary.csv.
 const char* end_reason_name(task::EndReason reason);
 
-/// Sets the task's fields the vehicle decides (thruster count, maximum thrust, control step)
-/// from the model.
-void apply_vehicle(const sim::VehicleModel& model, task::TaskConfig& task);
-
 /// Runs one episode in process; fills `trajectory` (when given) with the reset state first,
 /// then one row per control step.
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,

@@ -11,7 +11,7 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
                                int suite_episodes, int turned)
     : model_(model), task_(task) {
   config_.task = task;
-  apply_vehicle(model, config_.task);
+  task::apply_vehicle(model.facts(), config_.task);
   config_.suite_episodes = suite_episodes + turned;
   // Validation way-points of their own: the scenarios the run reports (test1, test2, fault
   // and the suite's seed 1) must not be the ones that choose the policy, or the reported

@@ -26,12 +26,15 @@
 #include "sim/vehicle_model.hpp"
 
 #include <yaml-cpp/yaml.h>
+#include <zlib.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -252,6 +255,15 @@ YAML::Node load_yaml(const std::string& path) {
   }
 }
 
+/// CRC-32 of the file's bytes (the vehicle's identity on the wire).
+std::uint32_t file_crc32(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in && !in.eof()) throw VehicleFileError(path, "(file)", "cannot read the file");
+  return static_cast<std::uint32_t>(
+      crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
+}
+
 /// Reads every block through vehicle_file_table(); ConfigError becomes VehicleFileError with
 /// the same dotted field and line.
 VehicleFile read_vehicle_file(const std::string& path, const YAML::Node& root) {
@@ -367,12 +379,10 @@ void build_allocation(const ModelChecker& check, VehicleModel& model) {
     model.allocation.col(i).head<3>() = t.direction_body;
     model.allocation.col(i).tail<3>() = t.position_body_m.cross(t.direction_body);
   }
-  const int rank = allocation_rank(model.allocation);
-  if (rank < kMinControllableDof) {
-    check.fail("thrusters", "the layout controls only " + std::to_string(rank) +
-                                " DOF (allocation singular values >= " +
-                                format_number(kAllocationMinSingularValue) +
-                                "); expected at least " + std::to_string(kMinControllableDof));
+  try {
+    model.controlled_axes = controlled_axes(model.allocation);
+  } catch (const std::invalid_argument& e) {
+    check.fail("thrusters", e.what());
   }
 }
 
@@ -436,6 +446,64 @@ int allocation_rank(const AllocationMatrix& allocation) {
   return rank;
 }
 
+namespace {
+
+/// Smallest singular value of the allocation's rows in `axes` (0 when none).
+double smallest_singular_value(const AllocationMatrix& allocation, const AxisSet& axes) {
+  Eigen::MatrixXd rows(0, allocation.cols());
+  for (int axis = 0; axis < 6; ++axis) {
+    if (!axes[static_cast<std::size_t>(axis)]) continue;
+    rows.conservativeResize(rows.rows() + 1, Eigen::NoChange);
+    rows.row(rows.rows() - 1) = allocation.row(axis);
+  }
+  if (rows.rows() == 0) return 0.0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(rows * rows.transpose(),
+                                                             Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(eigen.eigenvalues().minCoeff(), 0.0));
+}
+
+}  // namespace
+
+AxisSet controlled_axes(const AllocationMatrix& allocation) {
+  AxisSet axes{};
+  std::string missing;
+  for (Axis axis : {kSurge, kHeave, kYaw}) {
+    AxisSet alone{};
+    alone[axis] = true;
+    if (smallest_singular_value(allocation, alone) < kAllocationMinSingularValue) {
+      missing += std::string(missing.empty() ? "" : ", ") + kAxisNames[axis];
+    }
+    axes[axis] = true;
+  }
+  if (!missing.empty()) {
+    throw std::invalid_argument("the thrusters have no authority in " + missing +
+                                ": a vehicle needs surge, heave and yaw to reach way-points");
+  }
+  if (smallest_singular_value(allocation, axes) < kAllocationMinSingularValue) {
+    throw std::invalid_argument(
+        "the thrusters cannot drive surge, heave and yaw independently of each other (the "
+        "allocation's rows for them have a singular value under " +
+        format_number(kAllocationMinSingularValue) + ")");
+  }
+  for (Axis axis : {kSway, kPitch, kRoll}) {
+    AxisSet with = axes;
+    with[axis] = true;
+    if (smallest_singular_value(allocation, with) >= kAllocationMinSingularValue) axes = with;
+  }
+  return axes;
+}
+
+VehicleFacts VehicleModel::facts() const {
+  VehicleFacts f;
+  f.name = name;
+  f.source_file = source_file;
+  f.file_crc32 = file_crc32;
+  for (const Thruster& t : thrusters) f.thruster_names.push_back(t.name);
+  f.max_thrust_n = thruster_dynamics.max_thrust_n;
+  f.control_step_s = control_step_s;
+  return f;
+}
+
 void finalize_vehicle_model(VehicleModel& model) {
   const ModelChecker check(model);
   check_rigid_body(check, model);
@@ -460,6 +528,7 @@ config::SectionDoc vehicle_file_doc() { return config::section_doc(vehicle_file_
 VehicleModel load_vehicle_file(const std::string& path) {
   VehicleFile file = read_vehicle_file(path, load_yaml(path));
   file.model.source_file = path;
+  file.model.file_crc32 = file_crc32(path);
   apply_hydrostatics(file);
   finalize_vehicle_model(file.model);
   return std::move(file.model);

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,6 +14,8 @@ template <class T>
 class Table;
 struct SectionDoc;
 }  // namespace auvrl::config
+
+#include "common/vehicle_facts.hpp"
 
 namespace auvrl::sim {
 
@@ -58,6 +62,13 @@ struct ThrusterDynamics {
   double slew_rate_n_per_s = 21.6;    ///< 5.5 % of full throttle per 0.1 s, in N/s
 };
 
+/// The body DOF in the allocation's row order.
+enum Axis : int { kSurge = 0, kSway = 1, kHeave = 2, kRoll = 3, kPitch = 4, kYaw = 5 };
+/// Their names, for messages: "surge", "sway", "heave", "roll", "pitch", "yaw".
+inline constexpr const char* kAxisNames[6] = {"surge", "sway", "heave", "roll", "pitch", "yaw"};
+/// One flag per body DOF (Axis order).
+using AxisSet = std::array<bool, 6>;
+
 /// Integration scheme for one control step.
 enum class Integrator { kRk4, kSemiImplicitEuler };
 
@@ -72,6 +83,7 @@ struct BlowUpLimits {
 struct VehicleModel {
   std::string name;
   std::string source_file;
+  std::uint32_t file_crc32 = 0;  ///< CRC-32 of the file's bytes (0 for a model built in code)
 
   // Rigid body.
   double mass_kg = 0;
@@ -104,8 +116,13 @@ struct VehicleModel {
   Matrix6 mass_added = Matrix6::Zero();       ///< M_A = -diag(added_mass_derivatives)
   Matrix6 mass_total = Matrix6::Zero();       ///< M = M_RB + M_A
   Matrix6 mass_total_inverse = Matrix6::Zero();
+  /// The DOF the thrusters drive independently (controlled_axes(allocation)); the others are
+  /// left to the vehicle's own stability (Nessie VII's roll, BlueROV2's pitch).
+  AxisSet controlled_axes{};
 
   int num_thrusters() const { return static_cast<int>(thrusters.size()); }
+  /// The facts every process takes from the vehicle file (identity, thrusters, limits).
+  VehicleFacts facts() const;
 };
 
 /// Singular values of the allocation matrix below this do not count as control authority. The
@@ -113,12 +130,19 @@ struct VehicleModel {
 /// 0.1 is a 10 cm lever arm. Nessie VII's lateral thrusters sit about 5 cm above and below the
 /// centre of buoyancy, so its roll authority falls under it: five controllable DOF.
 inline constexpr double kAllocationMinSingularValue = 0.1;
-/// Fewest controllable DOF a vehicle file may have (a layout with less is rejected).
-inline constexpr int kMinControllableDof = 5;
 
 /// Number of singular values of the allocation matrix at or above kAllocationMinSingularValue:
 /// how many independent body-frame DOF the thrusters can drive.
 int allocation_rank(const AllocationMatrix& allocation);
+
+/// Which DOF the thrusters drive independently of each other. Surge, heave and yaw come first
+/// (without them no way-point is reachable); then sway, pitch and roll, each kept only if the
+/// allocation's rows of the chosen set still have every singular value at or above
+/// kAllocationMinSingularValue. A DOF left out is one the thrusters cannot move without also
+/// moving a chosen one (BlueROV2's pitch, made only by the surge thrusters' depth offset).
+/// Throws std::invalid_argument naming the missing DOF when surge, heave and yaw are not all
+/// independently controlled.
+AxisSet controlled_axes(const AllocationMatrix& allocation);
 
 /// Loads and validates a vehicle file; throws VehicleFileError naming file and field.
 VehicleModel load_vehicle_file(const std::string& path);

@@ -37,7 +37,7 @@ namespace {
 
 /// The evaluation's config as run_evaluation completes it from the model.
 eval::EvaluationConfig completed(eval::EvaluationConfig config, const sim::VehicleModel& model) {
-  eval::apply_vehicle(model, config.task);
+  task::apply_vehicle(model.facts(), config.task);
   config.task.max_steps = config.episode_steps;
   config.task.validate();
   return config;

@@ -90,7 +90,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   sim::VehicleModel plant = model;
   if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
-  eval::apply_vehicle(plant, t);
+  task::apply_vehicle(plant.facts(), t);
   t.max_steps = config.episode_steps;
   // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
   agent::EpisodeOptions options;

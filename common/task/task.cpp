@@ -265,4 +265,10 @@ StartState sample_start(const TaskConfig& c, std::mt19937_64& rng) {
   return random ? drawn : rest;
 }
 
+void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task) {
+  task.num_thrusters = vehicle.num_thrusters();
+  task.max_thrust_n = vehicle.max_thrust_n;
+  task.control_step_s = vehicle.control_step_s;
+}
+
 }  // namespace auvrl::task

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "common/vehicle_facts.hpp"
+
 namespace auvrl::config {
 template <class T>
 class Table;
@@ -63,8 +65,11 @@ struct ObservationScales {
 struct TaskConfig {
   StateLayout layout = StateLayout::kPaper;
   ObservationScales scales;
+  // The vehicle's facts (apply_vehicle; never set by a configuration file: the vehicle file
+  // is the one place they are written).
   int num_thrusters = 6;
   double max_thrust_n = 39.24;  ///< action +-1 maps to +-this, N
+  double control_step_s = 0.1;
 
   RewardKind reward = RewardKind::kPaper;
   double goal_reward = 10.0;  ///< on reaching the goal radius beta
@@ -92,7 +97,6 @@ struct TaskConfig {
   double precision_scale_m = 0.5;
 
   int max_steps = 700;  ///< 70 s of 0.1 s steps: a cut-off, not a terminal state
-  double control_step_s = 0.1;
 
   Eigen::Vector3d start_position_ned_m{0.0, 0.0, 5.0};
   double start_yaw_rad = 0.0;
@@ -116,6 +120,9 @@ struct TaskConfig {
   /// Throws std::invalid_argument naming the first unusable value.
   void validate() const;
 };
+
+/// Sets the fields the vehicle decides: thruster count, maximum thrust, control step.
+void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task);
 
 /// The keys of a `task:` section (common/task/task_yaml.cpp).
 const config::Table<TaskConfig>& task_table();

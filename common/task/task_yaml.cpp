@@ -48,7 +48,6 @@ void add_reward_fields(config::Table<TaskConfig>& t) {
 void add_episode_fields(config::Table<TaskConfig>& t) {
   using C = TaskConfig;
   t.field("max_steps", &C::max_steps, "steps", "episode length limit (700 = 70 s)");
-  t.field("control_step_s", &C::control_step_s, "s", "control step");
   t.field("start_position_ned_m", &C::start_position_ned_m, "m, NED", "start position");
   t.field("start_yaw_rad", &C::start_yaw_rad, "rad", "start heading");
   t.field("goal_min_ned_m", &C::goal_min_ned_m, "m, NED",
@@ -70,8 +69,6 @@ config::Table<TaskConfig> make_task_table() {
   t.choice("layout", &C::layout, parse_layout, to_string, "paper, extended, extended_thrust",
            "state layout (observation vector)");
   t.section("scales", make_scales_table(), &C::scales);
-  t.field("num_thrusters", &C::num_thrusters, "", "action size");
-  t.field("max_thrust_n", &C::max_thrust_n, "N", "action +-1 maps to +- this");
   add_reward_fields(t);
   add_episode_fields(t);
   return t;

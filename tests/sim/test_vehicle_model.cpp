@@ -76,6 +76,9 @@ TEST(VehicleModel, NessieAllocationHasFiveControllableDof) {
   EXPECT_NEAR(roll_row(3), -0.053, 1e-12);
   EXPECT_EQ(allocation_rank(m.allocation), 5);
   EXPECT_EQ(allocation_rank(bluerov().allocation), 6);
+  // Five controlled DOF: every one but roll.
+  EXPECT_EQ(m.controlled_axes, (AxisSet{true, true, true, false, true, true}));
+  EXPECT_EQ(bluerov().controlled_axes, (AxisSet{true, true, true, true, true, true}));
 }
 
 TEST(VehicleModel, BlueRov2Loads) {

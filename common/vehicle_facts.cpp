@@ -1,0 +1,24 @@
+#include "common/vehicle_facts.hpp"
+
+#include <fmt/format.h>
+
+namespace auvrl {
+
+std::string describe(const VehicleIdentity& identity) {
+  return fmt::format("'{}' ({} thrusters, file crc32 {:08x})", identity.name,
+                     identity.num_thrusters, identity.file_crc32);
+}
+
+std::string describe(const VehicleFacts& facts) {
+  return fmt::format("'{}' ({}: {} thrusters, file crc32 {:08x})", facts.name, facts.source_file,
+                     facts.num_thrusters(), facts.file_crc32);
+}
+
+std::string vehicle_mismatch_message(const std::string& who, const VehicleFacts& ours,
+                                     const std::string& peer, const VehicleIdentity& theirs) {
+  return fmt::format("{} expects vehicle {} but {} serves vehicle {}: name the same vehicle file "
+                     "for every process (auvrl train --vehicle FILE, or the run file's vehicle:)",
+                     who, describe(ours), peer, describe(theirs));
+}
+
+}  // namespace auvrl
