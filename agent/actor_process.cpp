@@ -23,10 +23,11 @@ void finish_actor_config(const ActorProcessOptions& options, ActorNodeConfig& co
   }
   const sim::VehicleModel model = sim::load_vehicle_file(options.vehicle_path);
   // Two instances: the PID keeps integrator state per episode it follows.
+  const PidGains gains = pid_gains_for(model).gains;  // X.pid.yaml beside the vehicle, or defaults
   if (config.demonstration_fraction > 0) {
-    config.demonstrator = std::make_shared<PidController>(model);
+    config.demonstrator = std::make_shared<PidController>(model, gains);
   }
-  if (config.expert_labels) config.expert = std::make_shared<PidController>(model);
+  if (config.expert_labels) config.expert = std::make_shared<PidController>(model, gains);
 }
 
 bool pin_to_cpu(int cpu, std::ostream& log) {

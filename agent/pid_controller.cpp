@@ -21,38 +21,6 @@ double wrap_angle(double a) {
 
 double clamp_abs(double v, double limit) { return std::clamp(v, -limit, limit); }
 
-void check_gains(const PidGains& g) {
-  const std::pair<const char*, double> values[] = {
-      {"surge_position_gain_per_s", g.surge_position_gain_per_s},
-      {"surge_speed_max_mps", g.surge_speed_max_mps},
-      {"sway_position_gain_per_s", g.sway_position_gain_per_s},
-      {"sway_speed_max_mps", g.sway_speed_max_mps},
-      {"heave_position_gain_per_s", g.heave_position_gain_per_s},
-      {"heave_speed_max_mps", g.heave_speed_max_mps},
-      {"velocity_gain_per_s", g.velocity_gain_per_s},
-      {"position_integral_gain_per_s2", g.position_integral_gain_per_s2},
-      {"integral_radius_m", g.integral_radius_m},
-      {"integral_force_max_n", g.integral_force_max_n},
-      {"yaw_gain_per_s", g.yaw_gain_per_s},
-      {"yaw_rate_max_rad_s", g.yaw_rate_max_rad_s},
-      {"yaw_rate_gain_per_s", g.yaw_rate_gain_per_s},
-      {"yaw_integral_gain_per_s2", g.yaw_integral_gain_per_s2},
-      {"yaw_integral_moment_max_nm", g.yaw_integral_moment_max_nm},
-      {"yaw_integral_window_rad", g.yaw_integral_window_rad},
-      {"heading_hold_radius_m", g.heading_hold_radius_m},
-      {"reverse_radius_m", g.reverse_radius_m},
-      {"pitch_max_rad", g.pitch_max_rad},
-      {"pitch_gain_per_s", g.pitch_gain_per_s},
-      {"pitch_rate_gain_per_s", g.pitch_rate_gain_per_s},
-  };
-  for (const auto& [name, value] : values) {
-    if (!std::isfinite(value) || value < 0) {
-      throw std::invalid_argument(std::string("PID gain ") + name +
-                                  " must be finite and >= 0, got " + std::to_string(value));
-    }
-  }
-}
-
 }  // namespace
 
 PidController::PidController(const sim::VehicleModel& model, PidGains gains)
@@ -61,7 +29,7 @@ PidController::PidController(const sim::VehicleModel& model, PidGains gains)
       max_thrust_n_(model.thruster_dynamics.max_thrust_n),
       control_step_s_(model.control_step_s),
       net_weight_n_(model.weight_n - model.buoyancy_n) {
-  check_gains(gains_);
+  check_pid_gains(gains_);
   if (num_thrusters_ < 1 || !(max_thrust_n_ > 0) || !(control_step_s_ > 0)) {
     throw std::invalid_argument("PID controller: vehicle model '" + model.name +
                                 "' has no thrusters, no maximum thrust or no control step");
@@ -74,14 +42,23 @@ PidController::PidController(const sim::VehicleModel& model, PidGains gains)
   // inverting it would ask for hundreds of newtons to make a roll moment the restoring moment
   // provides anyway. The other rows are dropped; the pseudo-inverse of the rest (a complete
   // orthogonal decomposition, once) is the minimum-norm thrust for the controlled DOF.
+  axes_ = model.controlled_axes;
+  for (int axis : {sim::kSurge, sim::kHeave, sim::kYaw}) {
+    if (!axes_[static_cast<std::size_t>(axis)]) {
+      throw std::invalid_argument("PID controller: vehicle model '" + model.name +
+                                  "' does not control " + sim::kAxisNames[axis] +
+                                  " (its controlled_axes); way-points need surge, heave and yaw");
+    }
+  }
   Eigen::MatrixXd b = model.allocation;
   for (Eigen::Index row = 0; row < 6; ++row) {
-    if (!model.controlled_axes[static_cast<std::size_t>(row)]) b.row(row).setZero();
+    if (!axes_[static_cast<std::size_t>(row)]) b.row(row).setZero();
   }
   pinv_ = Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd>(b).pseudoInverse();
   // Every DOF the controller drives must be reachable: B pinv must reproduce it.
   const Eigen::MatrixXd reproduced = b * pinv_;
-  for (int axis : {0, 1, 2, 4, 5}) {
+  for (int axis = 0; axis < 6; ++axis) {
+    if (!axes_[static_cast<std::size_t>(axis)]) continue;
     Eigen::Matrix<double, 6, 1> unit = Eigen::Matrix<double, 6, 1>::Zero();
     unit[axis] = 1.0;
     if ((reproduced * unit - unit).norm() > 1e-9) {
@@ -108,7 +85,7 @@ Eigen::VectorXd PidController::allocate(const Eigen::Matrix<double, 6, 1>& tau) 
   primary[0] = primary[1] = 0.0;
   Eigen::VectorXd f_primary = pinv_ * primary;
   const Eigen::VectorXd f_secondary = pinv_ * secondary;
-  // Heave, pitch and yaw first: if they alone exceed a thruster's limit, scale them together
+  // Heave, roll, pitch and yaw first: if they alone exceed a thruster's limit, scale them together
   // (keeps the moment's direction, unlike clipping one thruster).
   const double peak = f_primary.cwiseAbs().maxCoeff();
   if (peak > max_thrust_n_) f_primary *= max_thrust_n_ / peak;
@@ -123,17 +100,10 @@ Eigen::VectorXd PidController::allocate(const Eigen::Matrix<double, 6, 1>& tau) 
   return f_primary + alpha * f_secondary;
 }
 
-void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goal_ned_m,
-                        const task::StateVector& /*state*/, task::ActionVector& action) {
+double PidController::update_heading(const task::Observation& obs, const Eigen::Vector3d& error_ned,
+                                     double horizontal_m) {
   const PidGains& g = gains_;
-  const double dt = control_step_s_;
-  const Eigen::Matrix3d r_body_to_ned = task::body_to_ned(obs.euler_rpy_rad);
-  const Eigen::Vector3d error_ned = goal_ned_m - obs.position_ned_m;
-  const Eigen::Vector3d error_body = r_body_to_ned.transpose() * error_ned;
-  const double horizontal_m = error_ned.head<2>().norm();
-  const double distance_m = error_ned.norm();
   const double yaw = obs.euler_rpy_rad[2];
-
   // Heading reference: the bearing to the goal while it is well defined, else frozen.
   if (!heading_set_) {
     heading_ref_rad_ = yaw;
@@ -141,14 +111,31 @@ void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goa
   }
   if (horizontal_m > g.heading_hold_radius_m) {
     heading_ref_rad_ = std::atan2(error_ned[1], error_ned[0]);
+    // Without sway the heading alone takes lateral errors; near the goal the tail may point
+    // at it instead of the nose (surge backs up there), whichever needs the smaller turn.
+    if (!axes_[sim::kSway] && horizontal_m <= g.reverse_radius_m &&
+        std::abs(wrap_angle(heading_ref_rad_ - yaw)) > kPi / 2.0) {
+      heading_ref_rad_ = wrap_angle(heading_ref_rad_ + kPi);
+    }
   }
-  const double heading_error = wrap_angle(heading_ref_rad_ - yaw);
+  return wrap_angle(heading_ref_rad_ - yaw);
+}
 
-  // Outer loops: velocity references in the body frame.
+void PidController::translation_forces(const task::Observation& obs,
+                                       const Eigen::Matrix3d& r_body_to_ned,
+                                       const Eigen::Vector3d& error_ned, double horizontal_m,
+                                       double facing) {
+  const PidGains& g = gains_;
+  const double dt = control_step_s_;
+  const Eigen::Vector3d error_body = r_body_to_ned.transpose() * error_ned;
+  const double distance_m = error_ned.norm();
+
+  // Outer loops: velocity references in the body frame (no sway without sway authority).
   double u_ref = clamp_abs(g.surge_position_gain_per_s * error_body[0], g.surge_speed_max_mps);
-  const double facing = std::max(0.0, std::cos(heading_error));
   if (horizontal_m > g.reverse_radius_m) u_ref = std::max(0.0, u_ref) * facing * facing;
-  const double v_ref = clamp_abs(g.sway_position_gain_per_s * error_body[1], g.sway_speed_max_mps);
+  const double v_ref = axes_[sim::kSway] ? clamp_abs(g.sway_position_gain_per_s * error_body[1],
+                                                     g.sway_speed_max_mps)
+                                         : 0.0;
   const double w_ref =
       clamp_abs(g.heave_position_gain_per_s * error_body[2], g.heave_speed_max_mps);
   const Eigen::Vector3d vel_ref(u_ref, v_ref, w_ref);
@@ -164,7 +151,6 @@ void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goa
   // Restoring force of the net buoyancy in the body frame, cancelled by feed-forward.
   const Eigen::Vector3d down_body = r_body_to_ned.transpose() * Eigen::Vector3d::UnitZ();
 
-  tau_.setZero();
   for (int i = 0; i < 3; ++i) {
     const double v = obs.velocity_body_mps[i];
     const double feedback = mass_eff_[i] * g.velocity_gain_per_s * (vel_ref[i] - v);
@@ -173,28 +159,36 @@ void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goa
         mass_eff_[i] * g.position_integral_gain_per_s2 * integral_body[i], g.integral_force_max_n);
     tau_[i] = feedback + drag_ff + integral - net_weight_n_ * down_body[i];
   }
+  if (!axes_[sim::kSway]) tau_[1] = 0.0;
+}
 
-  // Yaw: heading error -> yaw-rate reference -> moment, with an integral for a steady moment
-  // (the fault's asymmetric surge thrust).
+double PidController::yaw_moment(const task::Observation& obs, double heading_error) {
+  const PidGains& g = gains_;
+  // Heading error -> yaw-rate reference -> moment, with an integral for a steady moment (the
+  // fault's asymmetric surge thrust).
   const double r_ref = clamp_abs(g.yaw_gain_per_s * heading_error, g.yaw_rate_max_rad_s);
   const double r = obs.angular_rate_body_rad_s[2];
   // Integrate only once the heading is nearly acquired: a half turn would otherwise wind it
   // up and overshoot. Stop at the clamp (anti-windup).
   if (std::abs(heading_error) < g.yaw_integral_window_rad) {
-    const double next = yaw_integral_ + heading_error * dt;
+    const double next = yaw_integral_ + heading_error * control_step_s_;
     if (std::abs(mass_eff_[5] * g.yaw_integral_gain_per_s2 * next) <=
         g.yaw_integral_moment_max_nm) {
       yaw_integral_ = next;
     }
   }
-  tau_[5] = mass_eff_[5] * g.yaw_rate_gain_per_s * (r_ref - r) +
-            drag_quad_[5] * r_ref * std::abs(r_ref) +
-            clamp_abs(mass_eff_[5] * g.yaw_integral_gain_per_s2 * yaw_integral_,
-                      g.yaw_integral_moment_max_nm);
+  return mass_eff_[5] * g.yaw_rate_gain_per_s * (r_ref - r) +
+         drag_quad_[5] * r_ref * std::abs(r_ref) +
+         clamp_abs(mass_eff_[5] * g.yaw_integral_gain_per_s2 * yaw_integral_,
+                   g.yaw_integral_moment_max_nm);
+}
 
-  // Pitch: nose toward the goal while driving to it far away, so that surge helps the slow
-  // heave (full heave is only 0.55 m/s); faded out between two and one heading-hold radii so
-  // the vehicle arrives and holds level.
+double PidController::pitch_moment(const task::Observation& obs, const Eigen::Vector3d& error_ned,
+                                   double horizontal_m, double facing) const {
+  const PidGains& g = gains_;
+  // Nose toward the goal while driving to it far away, so that surge helps the slow heave
+  // (Nessie VII's full heave is only 0.55 m/s); faded out between two and one heading-hold
+  // radii so the vehicle arrives and holds level.
   double pitch_ref = 0.0;
   if (g.heading_hold_radius_m > 0) {
     const double fade =
@@ -202,8 +196,30 @@ void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goa
     pitch_ref = fade * clamp_abs(-std::atan2(error_ned[2], horizontal_m), g.pitch_max_rad);
   }
   const double q_ref = g.pitch_gain_per_s * (pitch_ref - obs.euler_rpy_rad[1]);
-  tau_[4] = mass_eff_[4] * g.pitch_rate_gain_per_s * (q_ref - obs.angular_rate_body_rad_s[1]);
-  tau_[3] = 0.0;  // roll: passively stable, no authority (see the allocation)
+  return mass_eff_[4] * g.pitch_rate_gain_per_s * (q_ref - obs.angular_rate_body_rad_s[1]);
+}
+
+double PidController::roll_moment(const task::Observation& obs) const {
+  const PidGains& g = gains_;
+  if (!(g.roll_rate_gain_per_s > 0)) return 0.0;  // off: exactly no roll moment
+  const double p_ref = g.roll_gain_per_s * (0.0 - obs.euler_rpy_rad[0]);
+  return mass_eff_[3] * g.roll_rate_gain_per_s * (p_ref - obs.angular_rate_body_rad_s[0]);
+}
+
+void PidController::act(const task::Observation& obs, const Eigen::Vector3d& goal_ned_m,
+                        const task::StateVector& /*state*/, task::ActionVector& action) {
+  const Eigen::Matrix3d r_body_to_ned = task::body_to_ned(obs.euler_rpy_rad);
+  const Eigen::Vector3d error_ned = goal_ned_m - obs.position_ned_m;
+  const double horizontal_m = error_ned.head<2>().norm();
+  const double heading_error = update_heading(obs, error_ned, horizontal_m);
+  const double facing = std::max(0.0, std::cos(heading_error));
+
+  tau_.setZero();
+  translation_forces(obs, r_body_to_ned, error_ned, horizontal_m, facing);
+  tau_[5] = yaw_moment(obs, heading_error);
+  // Pitch and roll only where the thrusters drive them (else the vehicle's own stability).
+  tau_[4] = axes_[sim::kPitch] ? pitch_moment(obs, error_ned, horizontal_m, facing) : 0.0;
+  tau_[3] = axes_[sim::kRoll] ? roll_moment(obs) : 0.0;
 
   const Eigen::VectorXd thrust_n = allocate(tau_);
   action.resize(num_thrusters_);

@@ -389,7 +389,7 @@ std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& reque
     if (!request.policy_path.empty()) {
       throw std::invalid_argument("--policy and --controller pid exclude each other");
     }
-    return std::make_unique<agent::PidController>(model);
+    return std::make_unique<agent::PidController>(model, agent::pid_gains_for(model).gains);
   }
   if (request.controller != "policy") {
     throw std::invalid_argument("--controller '" + request.controller +

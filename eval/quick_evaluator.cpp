@@ -23,7 +23,7 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
     episodes_[static_cast<std::size_t>(i)].start.euler_rpy_rad[2] =
         (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
   }
-  agent::PidController pid(model_);
+  agent::PidController pid(model_, agent::pid_gains_for(model_).gains);
   reference_ = run(pid);
 }
 

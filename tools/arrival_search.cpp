@@ -136,7 +136,7 @@ ArrivalSearchResult search_fastest_arrival(
   const double dt = config.task.control_step_s;
 
   ArrivalSearchResult result;
-  agent::PidController pid(model);
+  agent::PidController pid(model, agent::pid_gains_for(model).gains);
   std::vector<agent::TrajectoryRow> pid_trajectory;
   const eval::SummaryRow pid_row =
       eval::run_evaluation_episode(model, config, pid, episode, &pid_trajectory);
@@ -370,14 +370,16 @@ ArrivalSearchResult run_arrival_search_request(const ArrivalSearchRequest& reque
   // The evaluation's own figures for the PID and for the found commands with the PID after.
   std::vector<eval::SummaryRow> rows;
   std::vector<agent::TrajectoryRow> trajectory;
-  agent::PidController pid(model);
+  agent::PidController pid(model, agent::pid_gains_for(model).gains);
   rows.push_back(eval::run_evaluation_episode(model, config, pid, episode, &trajectory));
   const int n = model.num_thrusters();
   eval::write_trajectory_csv(
       (fs::path(request.out_dir) / "trajectories" / ("pid_" + request.scenario + ".csv")).string(),
       trajectory, n);
   if (result.best_arrival_step > 0) {
-    OpenLoopController found(result.commands, n, std::make_unique<agent::PidController>(model));
+    OpenLoopController found(
+        result.commands, n,
+        std::make_unique<agent::PidController>(model, agent::pid_gains_for(model).gains));
     rows.push_back(eval::run_evaluation_episode(model, config, found, episode, &trajectory));
     eval::write_trajectory_csv(
         (fs::path(request.out_dir) / "trajectories" / ("open_loop_" + request.scenario + ".csv"))

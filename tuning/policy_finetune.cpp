@@ -78,7 +78,7 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
   arrival_only.hold_weight = 0.0;
   arrival_only.flip_margin_weight = 0.0;
   arrival_only.pid_lag_weight = 0.0;
-  agent::PidController pid(model);
+  agent::PidController pid(model, agent::pid_gains_for(model).gains);
   for (FinetuneEpisode& e : episodes) {
     e.pid_arrival_s = arrival_objective(model, task, pid, e, arrival_only);
   }

@@ -1,12 +1,16 @@
-// The controllers: the policy's size checks, and the PID baseline on the Nessie VII model
-// (allocation, limits, reaching test 1 well inside 70 s and holding station there).
+// The controllers: the policy's size checks, the PID baseline on the Nessie VII model
+// (allocation, limits, reaching test 1 well inside 70 s and holding station there), on vehicles
+// with other controlled DOF (no pitch, no sway, roll), and its per-vehicle gains files.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 #include "agent/controller.hpp"
 #include "agent/pid_controller.hpp"
+#include "common/config/yaml_config.hpp"
 #include "common/nn/mlp.hpp"
 #include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
@@ -196,6 +200,237 @@ TEST(PidController, TurnsBeforeDrivingWhenFacingAway) {
     if (row.time_s > 2.0) break;
     EXPECT_LT(std::abs(row.observation.velocity_body_mps[0]), 0.1) << "t = " << row.time_s;
   }
+}
+
+const sim::VehicleModel& heavy() {
+  static const sim::VehicleModel model =
+      sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/bluerov2_heavy.yaml");
+  return model;
+}
+
+/// A standard BlueROV2's layout built in code from the Heavy's model: its four vectored
+/// horizontal thrusters, and two vertical thrusters at the sides at x = 0 instead of the Heavy's
+/// four: surge, sway, heave, roll and yaw, but no pitch. With the Heavy's own figures (the
+/// horizontal thrusters 8.5 cm below the CG, the CB 1 cm above it) surge thrust alone pitches
+/// the nose up past 1.2 rad within a second, which no controller of the other DOF can stop;
+/// here they sit 2 cm below the CG and the CB 5 cm above it, so that the vehicle's own pitch
+/// stability (about 6.6 N m/rad) outweighs the pitch moment of surge (2 cm x the thrust).
+sim::VehicleModel no_pitch_vehicle() {
+  sim::VehicleModel model = heavy();
+  model.name = "bluerov2_no_pitch";
+  model.source_file.clear();  // built in code: no gains file beside it
+  model.file_crc32 = 0;
+  model.cob_body_m = Eigen::Vector3d(0.0, 0.0, -0.05);
+  model.thrusters.resize(6);
+  for (int i = 0; i < 4; ++i) model.thrusters[static_cast<std::size_t>(i)].position_body_m[2] = 0.02;
+  model.thrusters[4] = {"T5_starboard_vertical", {0.0, 0.218, 0.0}, {0.0, 0.0, -1.0}};
+  model.thrusters[5] = {"T6_port_vertical", {0.0, -0.218, 0.0}, {0.0, 0.0, -1.0}};
+  sim::finalize_vehicle_model(model);
+  return model;
+}
+
+/// Nessie VII without its two lateral thrusters: surge and yaw from T1/T2, heave and pitch
+/// from T5/T6, no sway.
+sim::VehicleModel no_sway_vehicle() {
+  sim::VehicleModel model = nessie();
+  model.name = "nessie7_no_sway";
+  model.source_file.clear();
+  model.file_crc32 = 0;
+  model.thrusters.erase(model.thrusters.begin() + 2, model.thrusters.begin() + 4);
+  sim::finalize_vehicle_model(model);
+  return model;
+}
+
+/// One evaluation episode of `steps` control steps to `goal` from the task's start, the
+/// trajectory and the PID's asked-for tau at every step.
+struct ShortRun {
+  eval::SummaryRow row;
+  std::vector<TrajectoryRow> trajectory;
+  std::vector<Tau> taus;
+};
+
+/// Records the PID's tau after every act().
+class TauRecorder final : public Controller {
+ public:
+  explicit TauRecorder(PidController& pid) : pid_(pid) {}
+  void reset() override {
+    pid_.reset();
+    taus.clear();
+  }
+  void act(const task::Observation& obs, const Eigen::Vector3d& goal, const task::StateVector& x,
+           task::ActionVector& action) override {
+    pid_.act(obs, goal, x, action);
+    taus.push_back(pid_.last_tau());
+  }
+  std::string name() const override { return "pid"; }
+  std::vector<Tau> taus;
+
+ private:
+  PidController& pid_;
+};
+
+ShortRun run_short(const sim::VehicleModel& model, PidController& pid, const Eigen::Vector3d& goal,
+                   int steps) {
+  eval::EvaluationConfig config;
+  config.task.num_thrusters = model.num_thrusters();
+  config.episode_steps = steps;
+  eval::EvaluationEpisode episode = eval::scenario_episodes(config, eval::Scenario::kTest1)[0];
+  episode.goal_ned_m = goal;
+  TauRecorder recorder(pid);
+  ShortRun r;
+  r.row = eval::run_evaluation_episode(model, config, recorder, episode, &r.trajectory);
+  r.taus = recorder.taus;
+  return r;
+}
+
+TEST(PidController, DrivesWhatANoPitchVehicleControlsAndAsksNoPitchMoment) {
+  const sim::VehicleModel model = no_pitch_vehicle();
+  ASSERT_FALSE(model.controlled_axes[sim::kPitch]);
+  ASSERT_TRUE(model.controlled_axes[sim::kSway]);
+  PidController pid(model);
+  // The pseudo-inverse reproduces every controlled DOF (surge comes with the pitch moment of
+  // thrusters 2 cm below the CG, which is no request) and leaves pitch out.
+  Eigen::MatrixXd b = model.allocation;
+  b.row(sim::kPitch).setZero();
+  for (int axis = 0; axis < 6; ++axis) {
+    if (!model.controlled_axes[static_cast<std::size_t>(axis)]) continue;
+    Tau unit = Tau::Zero();
+    unit[axis] = 1.0;
+    EXPECT_LT((b * pid.allocation_pseudo_inverse() * unit - unit).norm(), 1e-9) << axis;
+  }
+  EXPECT_LT(pid.allocation_pseudo_inverse().col(sim::kPitch).norm(), 1e-12);
+  // A way-point ahead, to the side and below: reached within 30 s, never a pitch moment asked.
+  const ShortRun r = run_short(model, pid, Eigen::Vector3d(5.0, 3.0, 8.0), 300);
+  EXPECT_TRUE(r.row.reached);
+  EXPECT_LT(r.row.final_error_m, 0.5);
+  ASSERT_EQ(r.taus.size(), 300u);
+  for (const Tau& tau : r.taus) ASSERT_EQ(tau[sim::kPitch], 0.0);
+}
+
+TEST(PidController, LeavesLateralErrorsToTheHeadingWithoutSway) {
+  const sim::VehicleModel model = no_sway_vehicle();
+  ASSERT_FALSE(model.controlled_axes[sim::kSway]);
+  ASSERT_TRUE(model.controlled_axes[sim::kPitch]);
+  PidController pid(model);
+  // Abeam of the start: the vehicle must turn to it, since it cannot slide sideways.
+  const ShortRun r = run_short(model, pid, Eigen::Vector3d(1.0, 6.0, 7.0), 400);
+  EXPECT_TRUE(r.row.reached);
+  EXPECT_LT(r.row.final_error_m, 0.5);
+  for (const Tau& tau : r.taus) ASSERT_EQ(tau[sim::kSway], 0.0);
+}
+
+TEST(PidController, HoldsRollLevelOnlyWhenItsGainsAreOn) {
+  // The Heavy controls roll; with the defaults (roll loop off) no roll moment is asked.
+  ASSERT_TRUE(heavy().controlled_axes[sim::kRoll]);
+  PidController off(heavy());
+  task::Observation obs;
+  obs.position_ned_m = Eigen::Vector3d(0, 0, 5);
+  obs.euler_rpy_rad = Eigen::Vector3d(0.3, 0.0, 0.0);
+  obs.angular_rate_body_rad_s = Eigen::Vector3d(0.2, 0.0, 0.0);
+  task::ActionVector action;
+  off.act(obs, Eigen::Vector3d(5.0, 0.0, 5.0), task::StateVector(), action);
+  EXPECT_EQ(off.last_tau()[sim::kRoll], 0.0);
+  PidGains gains;
+  gains.roll_gain_per_s = 1.0;
+  gains.roll_rate_gain_per_s = 2.0;
+  PidController on(heavy(), gains);
+  on.act(obs, Eigen::Vector3d(5.0, 0.0, 5.0), task::StateVector(), action);
+  const double inertia = heavy().mass_total(sim::kRoll, sim::kRoll);
+  EXPECT_NEAR(on.last_tau()[sim::kRoll], inertia * 2.0 * (1.0 * -0.3 - 0.2), 1e-12);
+  // Nessie VII has no roll authority: the gains are ignored there.
+  PidController nessie_pid(nessie(), gains);
+  nessie_pid.act(obs, Eigen::Vector3d(5.0, 0.0, 5.0), task::StateVector(), action);
+  EXPECT_EQ(nessie_pid.last_tau()[sim::kRoll], 0.0);
+}
+
+/// A scratch directory, removed at the end of the test.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    path = std::filesystem::temp_directory_path() /
+           ("auvrl_pid_gains_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(path);
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() { std::filesystem::remove_all(path); }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+TEST(PidGainsFile, SitsBesideTheVehicleFile) {
+  EXPECT_EQ(pid_gains_path("config/vehicles/bluerov2.yaml"), "config/vehicles/bluerov2.pid.yaml");
+  EXPECT_EQ(pid_gains_path("/a/b.yml"), "/a/b.pid.yaml");
+  EXPECT_EQ(pid_gains_path("/a/vehicle"), "/a/vehicle.pid.yaml");
+}
+
+TEST(PidGainsFile, RoundTripsExactly) {
+  const TempDir dir;
+  PidGains gains;
+  gains.surge_position_gain_per_s = 0.1234567890123456789;
+  gains.roll_rate_gain_per_s = 6.372918273645;
+  gains.integral_force_max_n = 1e-7;
+  write_pid_gains_file(dir.file("g.pid.yaml"), gains, "how it was made\n\nseed 1");
+  const PidGains back = read_pid_gains_file(dir.file("g.pid.yaml"));
+  EXPECT_EQ(pid_gains_text(back, ""), pid_gains_text(gains, ""));
+  EXPECT_EQ(back.surge_position_gain_per_s, gains.surge_position_gain_per_s);
+  EXPECT_EQ(back.roll_rate_gain_per_s, gains.roll_rate_gain_per_s);
+  // The header is comments; a key left out keeps its default.
+  EXPECT_EQ(pid_gains_text(gains, "a\nb").rfind("# a\n# b\n", 0), 0u);
+  write_text(dir.file("partial.pid.yaml"), "# only one\nyaw_gain_per_s: 0.3\n");
+  const PidGains partial = read_pid_gains_file(dir.file("partial.pid.yaml"));
+  EXPECT_EQ(partial.yaw_gain_per_s, 0.3);
+  EXPECT_EQ(partial.velocity_gain_per_s, PidGains{}.velocity_gain_per_s);
+}
+
+/// The ConfigError a gains file with `text` raises (fails the test if none).
+config::ConfigError gains_error(const TempDir& dir, const std::string& text) {
+  const std::string path = dir.file("bad.pid.yaml");
+  write_text(path, text);
+  try {
+    read_pid_gains_file(path);
+  } catch (const config::ConfigError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no error for: " << text;
+  return config::ConfigError("none");
+}
+
+TEST(PidGainsFile, RefusesBadKeysAndGainsNamingFileKeyAndLine) {
+  const TempDir dir;
+  const std::string path = dir.file("bad.pid.yaml");
+  const config::ConfigError unknown = gains_error(dir, "yaw_gain_per_s: 0.4\nyaw_gian: 1\n");
+  EXPECT_NE(std::string(unknown.what()).find(path), std::string::npos) << unknown.what();
+  EXPECT_NE(std::string(unknown.what()).find("yaw_gian"), std::string::npos) << unknown.what();
+  EXPECT_NE(std::string(unknown.what()).find("line 2"), std::string::npos) << unknown.what();
+  const config::ConfigError negative = gains_error(dir, "# c\npitch_gain_per_s: -1.2\n");
+  EXPECT_EQ(negative.key(), "pitch_gain_per_s");
+  EXPECT_NE(std::string(negative.what()).find(path), std::string::npos) << negative.what();
+  EXPECT_NE(std::string(negative.what()).find(">= 0"), std::string::npos) << negative.what();
+  EXPECT_EQ(gains_error(dir, "velocity_gain_per_s: .nan\n").key(), "velocity_gain_per_s");
+  EXPECT_EQ(gains_error(dir, "velocity_gain_per_s: .inf\n").key(), "velocity_gain_per_s");
+  EXPECT_EQ(gains_error(dir, "velocity_gain_per_s: fast\n").key(), "velocity_gain_per_s");
+}
+
+TEST(PidGainsFile, ChosenForAModelWhenBesideItsVehicleFile) {
+  const TempDir dir;
+  std::filesystem::copy_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/bluerov2_heavy.yaml",
+                             dir.file("rov.yaml"));
+  const sim::VehicleModel model = sim::load_vehicle_file(dir.file("rov.yaml"));
+  const VehiclePidGains none = pid_gains_for(model);
+  EXPECT_FALSE(none.from_file);
+  EXPECT_EQ(none.file, dir.file("rov.pid.yaml"));
+  EXPECT_EQ(pid_gains_text(none.gains, ""), pid_gains_text(PidGains{}, ""));
+  write_text(dir.file("rov.pid.yaml"), "roll_rate_gain_per_s: 4.5\n");
+  const VehiclePidGains found = pid_gains_for(model);
+  EXPECT_TRUE(found.from_file);
+  EXPECT_EQ(found.gains.roll_rate_gain_per_s, 4.5);
+  write_text(dir.file("rov.pid.yaml"), "roll_rate_gain: 4.5\n");
+  EXPECT_THROW(pid_gains_for(model), config::ConfigError);
+  // A model built in code has no file beside it.
+  EXPECT_FALSE(pid_gains_for(no_pitch_vehicle()).from_file);
+  EXPECT_TRUE(pid_gains_for(no_pitch_vehicle()).file.empty());
 }
 
 }  // namespace
