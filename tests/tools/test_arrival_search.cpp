@@ -47,7 +47,7 @@ TEST(ArrivalSearch, StartsFromThePidAndNeverEndsLater) {
   const eval::EvaluationConfig config = test_config();
   const ArrivalSearchResult r =
       search_fastest_arrival(nessie(), config, test1(config), small_search(10));
-  agent::PidController pid(nessie());
+  agent::PidController pid(nessie(), agent::pid_gains_for(nessie()).gains);  // the library's
   const eval::SummaryRow pid_row =
       eval::run_evaluation_episode(nessie(), config, pid, test1(config), nullptr);
   ASSERT_TRUE(pid_row.reached);
