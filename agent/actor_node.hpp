@@ -29,6 +29,9 @@ namespace auvrl::agent {
 struct ActorNodeConfig {
   int actor_id = 0;
   int vehicle_id = 0;  ///< its vehicle in auv_sim
+  /// The vehicle it expects (its file's facts); the simulator's every reset reply must name it.
+  /// task's thruster count, maximum thrust and control step are taken from it.
+  VehicleFacts vehicle;
   task::TaskConfig task;
   ExplorationNoise::Kind noise = ExplorationNoise::Kind::kOrnsteinUhlenbeck;
   double noise_sigma = 0.2;     ///< OU or Gaussian standard deviation (actions in [-1, 1])
@@ -39,6 +42,11 @@ struct ActorNodeConfig {
   double weights_request_period_s = 0.5;  ///< while it has no policy, ask this often
   double weights_silence_s = 10.0;        ///< with a policy: ask again after this long unheard
   std::int64_t max_episodes = 0;          ///< stop after this many (0: until told to stop)
+  /// An actor that discards this many episodes in a row (blow-ups, simulator timeouts), over
+  /// at least max_discarding_s, stops with an UnrecoverableFault naming the last cause: it
+  /// would otherwise run on without sending anything.
+  int max_discarded_in_row = 50;
+  double max_discarding_s = 5.0;
   /// Flow control: before an episode, wait while the learner owes more updates than this
   /// (0: never wait). Keeps the update-to-data ratio when actors outrun the learner.
   double max_learner_backlog = 0.0;
@@ -73,6 +81,7 @@ struct ActorCounters {
   std::int64_t transitions_sent = 0;
   std::int64_t batches_sent = 0;
   std::int64_t episodes_discarded = 0;  ///< blow-up or simulator timeout: nothing sent
+  std::int64_t discarded_in_row = 0;    ///< discarded since the last episode sent
   std::int64_t weights_applied = 0;
   std::int64_t weights_rejected = 0;  ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
@@ -108,6 +117,8 @@ class ActorNode {
   void refresh_policy();
   void send_experience(const std::vector<Transition>& transitions, const Eigen::Vector3d& goal);
   void send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal);
+  /// Counts a discarded episode; throws UnrecoverableFault when every episode is discarded.
+  void note_discarded(const EpisodeSummary& summary);
 
   ActorNodeConfig config_;
   transport::Transport& transport_;
@@ -117,6 +128,7 @@ class ActorNode {
   std::unique_ptr<ExploringController> controller_;
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
+  std::chrono::steady_clock::time_point last_sent_;  ///< the last episode sent, or the start
   std::mt19937_64 start_rng_;  ///< its own stream: exploring starts leave the goals unchanged
   std::mt19937_64 demonstration_rng_;
   bool last_was_demonstration_ = false;

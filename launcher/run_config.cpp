@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "common/config/table.hpp"
+#include "common/vehicle_facts.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/task/task_yaml.hpp"
 
@@ -81,9 +82,7 @@ const config::Table<tuning::FinetuneConfig>& finetune_table() {
 RunConfig read_run_config(const std::string& path) {
   RunConfig c;
   config::Section root = config::load_file(path);
-  std::string vehicle = "../vehicles/nessie7.yaml";
-  root.read("vehicle", vehicle);
-  c.vehicle_path = config::resolve_path(root, vehicle);
+  c.vehicle_path = read_vehicle_path(root);
   task::read_task_config(root.child("task"), c.task);
   config::Section learner = root.child("learner");
   learner.read("max_episodes", c.learner_max_episodes);

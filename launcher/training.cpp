@@ -40,8 +40,7 @@ RunContext load_run_context(const TrainOptions& options) {
   ctx.cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   ctx.actors = rc.run.actors > 0 ? rc.run.actors : ctx.cpus;
   ctx.model = sim::load_vehicle_file(rc.vehicle_path);
-  rc.task.num_thrusters = ctx.model.num_thrusters();
-  rc.task.max_thrust_n = ctx.model.thruster_dynamics.max_thrust_n;
+  task::apply_vehicle(ctx.model.facts(), rc.task);
   transport::apply_transport_arguments(options.transport_args, rc.transport);
   const bool dds = rc.transport.kind == transport::TransportKind::kDds;
   if (dds && rc.run.private_lockstep_bus && rc.transport.dds.domain_id + ctx.actors > 232) {
@@ -198,7 +197,9 @@ class TrainingSession {
   std::optional<std::string> show_progress();
   std::string status_line(double eta_s) const;
   void stop_processes();
-  void print_summary(int exit_code);
+  void print_summary(const SupervisionOutcome& outcome);
+  /// A simulator that serves another vehicle than the run's is a fault (vehicle_fault_).
+  void check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& heartbeat);
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -210,6 +211,7 @@ class TrainingSession {
   Supervisor supervisor_;
   TrainingFigures figures_;
   std::unique_ptr<BestPolicyKeeper> best_;
+  std::optional<std::string> vehicle_fault_;
   double start_s_ = clock_.now_s();
   double next_progress_s_ = 0;
   double next_best_eval_s_ = 0;
@@ -244,6 +246,7 @@ void TrainingSession::subscribe() {
       [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
         supervisor_.heard_from_pid(h.pid);
         figures_.sim_steps_per_s[h.pid] = h.steps_per_s;
+        check_simulated_vehicle(h);
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
       *transport_, channels::kLoggerHeartbeat,
@@ -325,9 +328,20 @@ std::optional<std::string> TrainingSession::show_progress() {
   return std::nullopt;
 }
 
+void TrainingSession::check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& h) {
+  const VehicleFacts ours = ctx_.model.facts();
+  const VehicleIdentity served{h.vehicle_name, h.num_thrusters,
+                               static_cast<std::uint32_t>(h.vehicle_file_crc32)};
+  if (!same_vehicle(identity_of(ours), served) && !vehicle_fault_) {
+    vehicle_fault_ = vehicle_mismatch_message(
+        "the run", ours, fmt::format("auv_sim (pid {}, {})", h.pid, h.vehicle_file), served);
+  }
+}
+
 SupervisionOutcome TrainingSession::supervise_pass() {
   transport_->handle(100);
   if (signals::stop_requested()) return {true, 130, "stopped by the user"};
+  if (vehicle_fault_) return {true, 1, *vehicle_fault_, false};
   if (ctx_.rc.run.max_train_s > 0 && wall_s() >= ctx_.rc.run.max_train_s) {
     return {true, 0,
             fmt::format("training budget of {} used", format_duration(ctx_.rc.run.max_train_s))};
@@ -352,7 +366,7 @@ void TrainingSession::stop_processes() {
   telemetry_.flush();
 }
 
-void TrainingSession::print_summary(int exit_code) {
+void TrainingSession::print_summary(const SupervisionOutcome& outcome) {
   const fs::path run_dir = ctx_.run_dir;
   std::string best_text;
   if (best_->has_best()) {
@@ -365,7 +379,9 @@ void TrainingSession::print_summary(int exit_code) {
        << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
        << "  policy       " << (run_dir / "policy.nn").string() << best_text << "\n"
        << "  logs         " << (run_dir / "logs").string() << "\n";
-  if (exit_code != 0) out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+  if (outcome.exit_code != 0 && outcome.resumable) {
+    out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+  }
 }
 
 TrainingResult TrainingSession::run() {
@@ -383,7 +399,7 @@ TrainingResult TrainingSession::run() {
   if (tty_) out_ << "\n";
   out_ << "auvrl train: " << outcome.stop_reason << "; stopping\n";
   stop_processes();
-  print_summary(outcome.exit_code);
+  print_summary(outcome);
   return {outcome.exit_code, std::move(best_)};
 }
 
