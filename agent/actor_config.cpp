@@ -32,12 +32,7 @@ config::Table<ActorNodeConfig> make_actor_table() {
   t.field("weights_silence_s", &C::weights_silence_s, "s",
           "with a policy: ask again after this long unheard");
   t.field("max_episodes", &C::max_episodes, "episodes, 0: until stopped", "stop after this many");
-  t.field("max_discarded_in_row", &C::max_discarded_in_row, "episodes",
-          "this many discarded episodes in a row (blow-up, simulator timeout)...")
-      .range(1);
-  t.field("max_discarding_s", &C::max_discarding_s, "s",
-          "...over at least this long stop the actor as a fault (never a silent run)")
-      .range(0);
+
   t.field("max_learner_backlog", &C::max_learner_backlog, "updates, 0: never wait",
           "before an episode, wait while the learner owes more updates than this...");
   t.field("max_wait_s", &C::max_wait_s, "s", "...but never longer than this");

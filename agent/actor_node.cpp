@@ -66,7 +66,6 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
   }
   if (!config_.expert_labels) config_.expert.reset();
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
-  last_sent_ = Clock::now();
 }
 
 ActorNode::~ActorNode() = default;
@@ -155,31 +154,12 @@ EpisodeSummary ActorNode::run_one_episode() {
   if (summary.end_reason == task::EndReason::kBlowUp ||
       summary.end_reason == task::EndReason::kSimTimeout) {
     // A numerical blow-up or a lost simulator: none of this episode is trusted.
-    note_discarded(summary);
+    ++counters_.episodes_discarded;
   } else {
     send_experience(transitions, options.goal_ned_m);
-    counters_.discarded_in_row = 0;
-    last_sent_ = Clock::now();
   }
   if (!last_was_demonstration_) send_report(summary, options.goal_ned_m);
   return summary;
-}
-
-void ActorNode::note_discarded(const EpisodeSummary& summary) {
-  ++counters_.episodes_discarded;
-  ++counters_.discarded_in_row;
-  const double discarding_s = std::chrono::duration<double>(Clock::now() - last_sent_).count();
-  if (counters_.discarded_in_row >= config_.max_discarded_in_row &&
-      discarding_s >= config_.max_discarding_s) {
-    const bool timeout = summary.end_reason == task::EndReason::kSimTimeout;
-    throw UnrecoverableFault(
-        "discarded every episode for " + std::to_string(static_cast<int>(discarding_s)) +
-        " s (" + std::to_string(counters_.discarded_in_row) + " in a row, nothing sent); the last " +
-        (timeout ? "because auv_sim's vehicle " + std::to_string(config_.vehicle_id) +
-                       " did not answer in time"
-                 : std::string("because the simulated vehicle blew up")) +
-        " (" + std::to_string(summary.length_steps) + " steps in)");
-  }
 }
 
 void ActorNode::send_experience(const std::vector<Transition>& transitions,

@@ -42,11 +42,6 @@ struct ActorNodeConfig {
   double weights_request_period_s = 0.5;  ///< while it has no policy, ask this often
   double weights_silence_s = 10.0;        ///< with a policy: ask again after this long unheard
   std::int64_t max_episodes = 0;          ///< stop after this many (0: until told to stop)
-  /// An actor that discards this many episodes in a row (blow-ups, simulator timeouts), over
-  /// at least max_discarding_s, stops with an UnrecoverableFault naming the last cause: it
-  /// would otherwise run on without sending anything.
-  int max_discarded_in_row = 50;
-  double max_discarding_s = 5.0;
   /// Flow control: before an episode, wait while the learner owes more updates than this
   /// (0: never wait). Keeps the update-to-data ratio when actors outrun the learner.
   double max_learner_backlog = 0.0;
@@ -81,7 +76,6 @@ struct ActorCounters {
   std::int64_t transitions_sent = 0;
   std::int64_t batches_sent = 0;
   std::int64_t episodes_discarded = 0;  ///< blow-up or simulator timeout: nothing sent
-  std::int64_t discarded_in_row = 0;    ///< discarded since the last episode sent
   std::int64_t weights_applied = 0;
   std::int64_t weights_rejected = 0;  ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
@@ -117,8 +111,6 @@ class ActorNode {
   void refresh_policy();
   void send_experience(const std::vector<Transition>& transitions, const Eigen::Vector3d& goal);
   void send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal);
-  /// Counts a discarded episode; throws UnrecoverableFault when every episode is discarded.
-  void note_discarded(const EpisodeSummary& summary);
 
   ActorNodeConfig config_;
   transport::Transport& transport_;
@@ -128,7 +120,6 @@ class ActorNode {
   std::unique_ptr<ExploringController> controller_;
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
-  std::chrono::steady_clock::time_point last_sent_;  ///< the last episode sent, or the start
   std::mt19937_64 start_rng_;  ///< its own stream: exploring starts leave the goals unchanged
   std::mt19937_64 demonstration_rng_;
   bool last_was_demonstration_ = false;

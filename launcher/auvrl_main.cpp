@@ -116,6 +116,8 @@ int run_train(int argc, const char* const* argv) {
   cli.option("finetune-iterations", &options.finetune_iterations,
              "fine-tuning iterations after training (default: finetune.iterations, 0 = none)");
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
+  cli.option("bin-dir", &options.bin_dir,
+             "where auv_sim, auv_actor, auv_learner and auv_logger are (default: beside auvrl)");
   cli.option("network", &network,
              "private (default: own network namespace) or host (LCM on the host's network)");
   cli.choices("network", {"private", "host"});

@@ -32,6 +32,9 @@ config::Table<RunSettings> make_run_table() {
   t.field("restart_window_s", &C::restart_window_s, "s", "see max_restarts");
   t.field("heartbeat_timeout_s", &C::heartbeat_timeout_s, "s, 0: not watched",
           "a process silent this long is taken as hung and restarted");
+  t.field("discard_fault_s", &C::discard_fault_s, "s",
+          "an actor discarding every episode this long (its simulator alive) ends the run")
+      .range(0.1);
   return t;
 }
 

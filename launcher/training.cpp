@@ -20,6 +20,7 @@
 #include "common/signals.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
+#include "eval/evaluation.hpp"
 #include "launcher/format.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/telemetry.hpp"
@@ -161,6 +162,15 @@ struct TrainingFigures {
   std::optional<auvrl_lcm::learner_stats_t> last_stats;
   std::int64_t learner_episodes = 0;
   std::map<int, double> sim_steps_per_s;  ///< by simulator process id
+  std::map<int, double> sim_heard_s;      ///< the last heartbeat by simulator process id, s
+  /// Per actor id: since when every episode it reported was discarded (blow-up or simulator
+  /// timeout: nothing sent to the learner), how many, and the last one's end reason.
+  struct Discarding {
+    double since_s = 0;
+    std::int64_t episodes = 0;
+    int last_reason = 0;
+  };
+  std::map<int, Discarding> discarding;
 
   double success_rate() const {
     const auto successes = std::count(recent_success.begin(), recent_success.end(), true);
@@ -200,6 +210,11 @@ class TrainingSession {
   void print_summary(const SupervisionOutcome& outcome);
   /// A simulator that serves another vehicle than the run's is a fault (vehicle_fault_).
   void check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& heartbeat);
+  /// Follows each actor's run of discarded episodes.
+  void note_discarded(const auvrl_lcm::episode_report_t& report);
+  /// An actor that has discarded every episode for run.discard_fault_s while its simulator
+  /// answers heartbeats: the run learns nothing (a hung simulator is the supervisor's).
+  std::optional<std::string> discarding_actor() const;
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -231,6 +246,7 @@ void TrainingSession::subscribe() {
         figures_.beta_m = e.beta_m;
         figures_.recent_success.push_back(e.success);
         if (figures_.recent_success.size() > 100) figures_.recent_success.pop_front();
+        note_discarded(e);
         telemetry_.episodes.add(wall_s(), e);
       });
   transport::subscribe<auvrl_lcm::learner_stats_t>(
@@ -246,6 +262,7 @@ void TrainingSession::subscribe() {
       [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
         supervisor_.heard_from_pid(h.pid);
         figures_.sim_steps_per_s[h.pid] = h.steps_per_s;
+        figures_.sim_heard_s[h.pid] = clock_.now_s();
         check_simulated_vehicle(h);
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
@@ -338,10 +355,41 @@ void TrainingSession::check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& 
   }
 }
 
+void TrainingSession::note_discarded(const auvrl_lcm::episode_report_t& report) {
+  const auto reason = static_cast<task::EndReason>(report.end_reason);
+  if (reason != task::EndReason::kBlowUp && reason != task::EndReason::kSimTimeout) {
+    figures_.discarding.erase(report.actor_id);
+    return;
+  }
+  auto [entry, first] = figures_.discarding.try_emplace(report.actor_id);
+  if (first) entry->second.since_s = clock_.now_s();
+  ++entry->second.episodes;
+  entry->second.last_reason = report.end_reason;
+}
+
+std::optional<std::string> TrainingSession::discarding_actor() const {
+  const double now = clock_.now_s();
+  for (const auto& [actor, run] : figures_.discarding) {
+    if (now - run.since_s < ctx_.rc.run.discard_fault_s) continue;
+    const int sim_pid = supervisor_.pid("sim" + std::to_string(actor));
+    const auto heard = figures_.sim_heard_s.find(sim_pid);
+    if (heard == figures_.sim_heard_s.end() || now - heard->second > 3.0) continue;
+    return fmt::format(
+        "actor{} discarded every episode for {:.0f} s ({} episodes, the last ended by {}) while "
+        "its simulator answers: nothing reaches the learner (see {}/processes/actor{}.log and "
+        "sim{}.log)",
+        actor, now - run.since_s, run.episodes,
+        eval::end_reason_name(static_cast<task::EndReason>(run.last_reason)), ctx_.run_dir, actor,
+        actor);
+  }
+  return std::nullopt;
+}
+
 SupervisionOutcome TrainingSession::supervise_pass() {
   transport_->handle(100);
   if (signals::stop_requested()) return {true, 130, "stopped by the user"};
   if (vehicle_fault_) return {true, 1, *vehicle_fault_, false};
+  if (auto discarding = discarding_actor()) return {true, 1, *discarding};
   if (ctx_.rc.run.max_train_s > 0 && wall_s() >= ctx_.rc.run.max_train_s) {
     return {true, 0,
             fmt::format("training budget of {} used", format_duration(ctx_.rc.run.max_train_s))};
