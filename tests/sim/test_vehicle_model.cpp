@@ -133,16 +133,19 @@ TEST(VehicleModel, BlueRov2StandardLoads) {
   EXPECT_GT(m.buoyancy_n - m.weight_n, 1.5);
   EXPECT_LT(m.buoyancy_n - m.weight_n, 2.5);
   EXPECT_NEAR(m.cog_body_m.z() - m.cob_body_m.z(), 0.02, 1e-12);
-  // The horizontal thrusters are the Heavy's T1..T4.
+  // The horizontal thrusters sit where the Heavy's T1..T4 do in x and y, 1.1 cm below the CG.
   for (std::size_t i = 0; i < 4; ++i) {
-    EXPECT_EQ(m.thrusters[i].position_body_m, bluerov().thrusters[i].position_body_m) << i;
+    EXPECT_EQ(m.thrusters[i].position_body_m.head<2>(),
+              bluerov().thrusters[i].position_body_m.head<2>())
+        << i;
+    EXPECT_DOUBLE_EQ(m.thrusters[i].position_body_m.z(), 0.011) << i;
     EXPECT_EQ(m.thrusters[i].direction_body, bluerov().thrusters[i].direction_body) << i;
   }
   // Surge, sway, heave, roll and yaw controlled; pitch is only the surge thrusters' depth
-  // (pitch row = 0.085 m x surge row), so it is left to the CB-over-CG moment.
+  // (pitch row = 0.011 m x surge row), so it is left to the CB-over-CG moment.
   EXPECT_EQ(m.controlled_axes, (AxisSet{true, true, true, true, false, true}));
   EXPECT_EQ(allocation_rank(m.allocation), 5);
-  EXPECT_LT((m.allocation.row(kPitch) - 0.085 * m.allocation.row(kSurge)).cwiseAbs().maxCoeff(),
+  EXPECT_LT((m.allocation.row(kPitch) - 0.011 * m.allocation.row(kSurge)).cwiseAbs().maxCoeff(),
             1e-12);
   // Roll from the two vertical thrusters' 0.109 m arms, heave from their sum.
   const Vector6 roll = m.allocation * thrusts({0, 0, 0, 0, -1, 1});
