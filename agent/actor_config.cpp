@@ -1,6 +1,7 @@
 #include "agent/actor_config.hpp"
 
 #include "common/config/table.hpp"
+#include "common/vehicle_facts.hpp"
 #include "common/task/task_yaml.hpp"
 
 namespace auvrl::agent {
@@ -31,6 +32,7 @@ config::Table<ActorNodeConfig> make_actor_table() {
   t.field("weights_silence_s", &C::weights_silence_s, "s",
           "with a policy: ask again after this long unheard");
   t.field("max_episodes", &C::max_episodes, "episodes, 0: until stopped", "stop after this many");
+
   t.field("max_learner_backlog", &C::max_learner_backlog, "updates, 0: never wait",
           "before an episode, wait while the learner owes more updates than this...");
   t.field("max_wait_s", &C::max_wait_s, "s", "...but never longer than this");
@@ -60,11 +62,8 @@ const config::Table<ActorNodeConfig>& actor_table() {
 void read_actor_config_file(const std::string& path, ActorNodeConfig& c,
                             std::string* vehicle_path) {
   config::Section root = config::load_file(path);
-  if (vehicle_path) {
-    std::string vehicle = *vehicle_path;
-    root.read("vehicle", vehicle);
-    if (!vehicle.empty()) *vehicle_path = config::resolve_path(root, vehicle);
-  }
+  const std::string vehicle = read_vehicle_path(root);
+  if (vehicle_path) *vehicle_path = vehicle;
   task::read_task_config(root.child("task"), c.task);
   const task::GoalSchedule schedule =
       task::read_goal_schedule(root.child("schedule"), task::GoalSchedule());

@@ -8,6 +8,7 @@
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/random.hpp"
+#include "common/unrecoverable.hpp"
 
 namespace auvrl::agent {
 
@@ -40,7 +41,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       transport_(transport),
       log_(log),
       link_(make_lockstep_link(lockstep_transport ? *lockstep_transport : transport,
-                               config_.vehicle_id, config_.task.num_thrusters, config_.lockstep)),
+                               config_.vehicle_id, config_.vehicle, config_.lockstep)),
       weights_(transport, channels::kPolicyWeights, 8),
       controller_(std::make_unique<ExploringController>(*this)),
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
@@ -50,6 +51,10 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       demonstration_rng_(config_.seed * 0x94D049BB133111EBull + 11),
       policy_(config_.task.state_dim(), config_.task.num_thrusters, config_.initial_beta_m) {
   config_.task.validate();
+  if (config_.vehicle.num_thrusters() != config_.task.num_thrusters) {
+    throw std::invalid_argument("actor: the task's " + std::to_string(config_.task.num_thrusters) +
+                                " thrusters are not the vehicle's " + describe(config_.vehicle));
+  }
   if (!(config_.demonstration_fraction >= 0 && config_.demonstration_fraction <= 1)) {
     throw std::invalid_argument("actor.demonstration_fraction must be in [0, 1]");
   }
@@ -78,6 +83,10 @@ void ActorNode::refresh_policy() {
       case WeightsOutcome::kRefreshed:
         last_weights_ = Clock::now();
         break;
+      case WeightsOutcome::kWrongSizes:
+        throw UnrecoverableFault(error + " (vehicle " + describe(config_.vehicle) + ", " +
+                                 task::to_string(config_.task.layout) +
+                                 " layout): the learner serves another vehicle or layout");
       case WeightsOutcome::kRejected:
         ++counters_.weights_rejected;
         log_ << "auv_actor " << config_.actor_id << ": weights version " << msg->version

@@ -29,6 +29,9 @@ namespace auvrl::agent {
 struct ActorNodeConfig {
   int actor_id = 0;
   int vehicle_id = 0;  ///< its vehicle in auv_sim
+  /// The vehicle it expects (its file's facts); the simulator's every reset reply must name it.
+  /// task's thruster count, maximum thrust and control step are taken from it.
+  VehicleFacts vehicle;
   task::TaskConfig task;
   ExplorationNoise::Kind noise = ExplorationNoise::Kind::kOrnsteinUhlenbeck;
   double noise_sigma = 0.2;     ///< OU or Gaussian standard deviation (actions in [-1, 1])

@@ -14,14 +14,12 @@ namespace auvrl::agent {
 void finish_actor_config(const ActorProcessOptions& options, ActorNodeConfig& config) {
   config.vehicle_id = options.vehicle_id >= 0 ? options.vehicle_id : config.actor_id;
   config.seed = static_cast<std::uint64_t>(options.seed);
+  const sim::VehicleModel model = sim::load_vehicle_file(
+      options.vehicle_path.empty() ? default_vehicle_file() : options.vehicle_path);
+  config.vehicle = model.facts();
+  task::apply_vehicle(config.vehicle, config.task);
   config.task.validate();
   if (config.demonstration_fraction <= 0 && !config.expert_labels) return;
-  if (options.vehicle_path.empty()) {
-    throw std::invalid_argument(
-        "demonstrations and expert labels need the vehicle file (vehicle: in the run file, "
-        "or --vehicle)");
-  }
-  const sim::VehicleModel model = sim::load_vehicle_file(options.vehicle_path);
   // Two instances: the PID keeps integrator state per episode it follows.
   const PidGains gains = pid_gains_for(model).gains;  // X.pid.yaml beside the vehicle, or defaults
   if (config.demonstration_fraction > 0) {
@@ -73,7 +71,8 @@ void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions&
   if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
   signals::install_stop_handlers();
   ActorNode node(config, *transport, log, lockstep.get());
-  log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << ", "
+  log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << " "
+      << describe(config.vehicle) << ", "
       << task::to_string(config.task.layout) << " state (" << config.task.state_dim() << "), "
       << task::to_string(config.task.reward) << " reward, seed " << options.seed << "\n";
   run_actor_episodes(node, config, options.report_every, log);

@@ -17,13 +17,12 @@ struct ActorProcessOptions {
   int pin_cpu = -1;          ///< pin the process to this CPU (-1: no)
   int report_every = 50;     ///< a log line every N policy episodes
   std::int64_t seed = 1;     ///< way-points and noise
-  std::string vehicle_path;  ///< the PID demonstrator's/expert's vehicle file
+  std::string vehicle_path;  ///< the vehicle file ("": default_vehicle_file())
 };
 
-/// Completes `config` from `options` (vehicle id, seed), validates the task and builds the
-/// demonstrator and expert from the vehicle file when the configuration asks for them. Throws
-/// std::invalid_argument when demonstrations or expert labels lack the vehicle file, and
-/// whatever validating or loading throws.
+/// Completes `config` from `options` (vehicle id, seed, the vehicle file's facts into the task),
+/// validates the task and builds the demonstrator and expert from the vehicle file when the
+/// configuration asks for them. Throws whatever validating or loading throws.
 void finish_actor_config(const ActorProcessOptions& options, ActorNodeConfig& config);
 
 /// Pins the calling process to `cpu`; false (and a warning on `log`) when that fails.

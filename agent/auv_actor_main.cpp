@@ -9,6 +9,7 @@
 #include "common/cli.hpp"
 #include "common/config/table.hpp"
 #include "common/transport_options.hpp"
+#include "common/unrecoverable.hpp"
 
 int main(int argc, char** argv) {
   using namespace auvrl;
@@ -41,7 +42,7 @@ int main(int argc, char** argv) {
   cmd.option("pin-cpu", &options.pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &options.report_every, "a log line every N episodes");
   cmd.option("vehicle", &options.vehicle_path,
-             "vehicle file of the PID demonstrator/expert (YAML)");
+             "vehicle file (default: the run file's vehicle:, else config/vehicles/nessie7.yaml)");
   transport::add_transport_options(cmd, transport_config);
   transport::add_lockstep_options(cmd, lockstep_bus);
   try {
@@ -54,6 +55,9 @@ int main(int argc, char** argv) {
   if (options.pin_cpu >= 0) agent::pin_to_cpu(options.pin_cpu, std::cerr);
   try {
     agent::run_actor_process(config, options, transport_config, lockstep_bus, std::cerr);
+  } catch (const UnrecoverableFault& e) {
+    std::cerr << "auv_actor " << config.actor_id << ": " << e.what() << "\n";
+    return kExitUnrecoverable;
   } catch (const std::exception& e) {
     std::cerr << "auv_actor: " << e.what() << "\n";
     return 1;

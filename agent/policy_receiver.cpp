@@ -40,6 +40,14 @@ WeightsOutcome PolicyReceiver::apply(const auvrl_lcm::policy_weights_t& msg, std
       return reject("policy network " + network.spec().describe() + " has no tanh output");
     }
     if (!network.params().allFinite()) return reject("non-finite parameters in the network");
+    const nn::MlpSpec& spec = network.spec();
+    if (spec.input_dim != state_dim_ || spec.output_dim != num_thrusters_ ||
+        spec.extra_input_dim != 0) {
+      reject("weights version " + std::to_string(msg.version) + " hold a policy network " +
+             spec.describe() + "; this actor's task needs in=" + std::to_string(state_dim_) +
+             " out=" + std::to_string(num_thrusters_));
+      return WeightsOutcome::kWrongSizes;
+    }
     auto policy =
         std::make_unique<PolicyController>(std::move(network), state_dim_, num_thrusters_);
     policy_ = std::move(policy);

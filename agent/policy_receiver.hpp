@@ -17,6 +17,9 @@ enum class WeightsOutcome {
   kApplied,    ///< a new network (or the first one) is in place
   kRefreshed,  ///< same version as held: only the schedule fields were taken
   kRejected,   ///< refused (see the error): nothing of the message was applied
+  /// A sound network whose sizes do not fit this actor's task: a learner of another vehicle or
+  /// layout (see the error). Nothing was applied; no later message will fit either.
+  kWrongSizes,
 };
 
 /// Holds the newest policy (and the learner's schedule fields) taken from weights messages.
@@ -27,7 +30,7 @@ class PolicyReceiver {
   /// Applies msg if every check passes: finite beta_m > 0 and updates_owed >= 0, version >= 0,
   /// num_bytes equal to the network's size, a network that parses (magic, format, sizes,
   /// CRC-32), fits the task (inputs, outputs, tanh output) and has only finite parameters.
-  /// On kRejected, error says why and nothing changed.
+  /// On kRejected or kWrongSizes, error says why and nothing changed.
   WeightsOutcome apply(const auvrl_lcm::policy_weights_t& msg, std::string& error);
 
   /// The policy, or nullptr before the first accepted weights.

@@ -1,6 +1,7 @@
 #include "agent/vehicle_link.hpp"
 
 #include "common/sim_client.hpp"
+#include "common/unrecoverable.hpp"
 
 namespace auvrl::agent {
 
@@ -57,9 +58,12 @@ class InProcessLink final : public VehicleLink {
 
 class LockstepLink final : public VehicleLink {
  public:
-  LockstepLink(transport::Transport& transport, int vehicle_id, int num_thrusters,
+  LockstepLink(transport::Transport& transport, int vehicle_id, const VehicleFacts& expected,
                LockstepTiming timing)
-      : client_(transport, vehicle_id, timing), num_thrusters_(num_thrusters) {}
+      : client_(transport, vehicle_id, timing),
+        vehicle_id_(vehicle_id),
+        expected_(expected),
+        num_thrusters_(expected.num_thrusters()) {}
   int num_thrusters() const override { return num_thrusters_; }
 
   std::optional<VehicleReport> reset(const EpisodeStart& start) override {
@@ -74,7 +78,9 @@ class LockstepLink final : public VehicleLink {
     msg.num_thrusters = static_cast<std::int8_t>(start.thruster_efficiency.size());
     msg.thruster_efficiency = start.thruster_efficiency;
     msg.seed = static_cast<std::int64_t>(start.seed);
-    return convert(client_.reset(msg));
+    const std::optional<auvrl_lcm::vehicle_state_t> reply = client_.reset(msg);
+    if (reply) check_vehicle(*reply);
+    return convert(reply);
   }
 
   std::optional<VehicleReport> step(const std::vector<double>& thrust_n) override {
@@ -97,7 +103,20 @@ class LockstepLink final : public VehicleLink {
     return r;
   }
 
+  /// The reply must come from the vehicle this actor expects.
+  void check_vehicle(const auvrl_lcm::vehicle_state_t& reply) const {
+    const VehicleIdentity served{reply.vehicle_name, reply.num_thrusters,
+                                 static_cast<std::uint32_t>(reply.vehicle_file_crc32)};
+    if (!same_vehicle(identity_of(expected_), served)) {
+      throw UnrecoverableFault(vehicle_mismatch_message(
+          "this actor", expected_, "auv_sim (vehicle id " + std::to_string(vehicle_id_) + ")",
+          served));
+    }
+  }
+
   SimClient client_;
+  int vehicle_id_;
+  VehicleFacts expected_;
   int num_thrusters_;
 };
 
@@ -108,8 +127,9 @@ std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model
 }
 
 std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
-                                                int num_thrusters, LockstepTiming timing) {
-  return std::make_unique<LockstepLink>(transport, vehicle_id, num_thrusters, timing);
+                                                const VehicleFacts& expected,
+                                                LockstepTiming timing) {
+  return std::make_unique<LockstepLink>(transport, vehicle_id, expected, timing);
 }
 
 }  // namespace auvrl::agent

@@ -47,8 +47,11 @@ class VehicleLink {
 std::unique_ptr<VehicleLink> make_in_process_link(const sim::VehicleModel& model);
 
 /// One vehicle of auv_sim over the transport, in lockstep; a step or reset unanswered within
-/// timing.timeout_ms is sent again, up to timing.attempts times, then reported as lost.
+/// timing.timeout_ms is sent again, up to timing.attempts times, then reported as lost. Every
+/// reset reply must name `expected` (name, thruster count, file CRC-32): another vehicle throws
+/// UnrecoverableFault naming both.
 std::unique_ptr<VehicleLink> make_lockstep_link(transport::Transport& transport, int vehicle_id,
-                                                int num_thrusters, LockstepTiming timing = {});
+                                                const VehicleFacts& expected,
+                                                LockstepTiming timing = {});
 
 }  // namespace auvrl::agent

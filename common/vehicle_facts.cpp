@@ -2,7 +2,17 @@
 
 #include <fmt/format.h>
 
+#include "common/config/yaml_config.hpp"
+
 namespace auvrl {
+
+std::string default_vehicle_file() { return std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml"; }
+
+std::string read_vehicle_path(config::Section& root) {
+  std::string vehicle;
+  root.read("vehicle", vehicle);
+  return vehicle.empty() ? default_vehicle_file() : config::resolve_path(root, vehicle);
+}
 
 std::string describe(const VehicleIdentity& identity) {
   return fmt::format("'{}' ({} thrusters, file crc32 {:08x})", identity.name,

@@ -9,6 +9,17 @@
 
 namespace auvrl {
 
+namespace config {
+class Section;
+}  // namespace config
+
+/// The vehicle a process simulates or controls when nothing names one: the source tree's
+/// config/vehicles/nessie7.yaml (the paper's vehicle).
+std::string default_vehicle_file();
+
+/// A run file's `vehicle:` resolved against the file's folder, or default_vehicle_file().
+std::string read_vehicle_path(config::Section& root);
+
 /// The vehicle's identity and the facts the task needs: thrusters, maximum thrust, control step.
 struct VehicleFacts {
   std::string name;                         ///< the vehicle file's `name:`

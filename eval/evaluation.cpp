@@ -236,7 +236,10 @@ std::vector<SummaryRow> run_evaluation(const sim::VehicleModel& model, Evaluatio
       }
     }
   }
-  if (!out_dir.empty()) write_summary_csv((dir / "summary.csv").string(), rows);
+  if (!out_dir.empty()) {
+    write_summary_csv((dir / "summary.csv").string(), rows);
+    write_vehicle_csv((dir / "vehicle.csv").string(), model.facts());
+  }
   return rows;
 }
 
@@ -291,6 +294,17 @@ void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& r
       out.empty().empty();  // never reached: both cells empty
     }
     out.cell(r.final_error_m).cell(r.thrust_energy).cell(end_reason_name(r.end_reason));
+    out.end_row();
+  }
+  out.flush();
+}
+
+void write_vehicle_csv(const std::string& path, const VehicleFacts& vehicle) {
+  csv::Writer out(path, {"vehicle", "file", "thruster", "name", "max_thrust_n"},
+                  csv::Mode::kTruncate, kCsvDigits);
+  for (int i = 0; i < vehicle.num_thrusters(); ++i) {
+    out.cell(vehicle.name).cell(vehicle.source_file).cell(i + 1);
+    out.cell(vehicle.thruster_names[static_cast<std::size_t>(i)]).cell(vehicle.max_thrust_n);
     out.end_row();
   }
   out.flush();

@@ -13,6 +13,7 @@
 //            seed, from the fixed start.
 //
 // Files written to DIR:
+//   vehicle.csv    the vehicle and its thrusters (write_vehicle_csv)
 //   summary.csv    one row per episode: scenario, controller, episode, goal_x, goal_y, goal_z
 //                  (NED, m), reached (1 if ever within 0.5 m), time_to_reach_s (first time
 //                  within 0.5 m; EMPTY if never), mean_error_after_reach_m (mean distance from
@@ -133,6 +134,10 @@ struct ValidationScore {
 /// run by the reference controller); throws std::invalid_argument if they do not match.
 ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
                                         const std::vector<SummaryRow>& reference);
+
+/// Writes vehicle.csv: the vehicle evaluated (name, file) and its thrusters (number from 1,
+/// name, maximum thrust in N), one row per thruster, for the plots' labels.
+void write_vehicle_csv(const std::string& path, const VehicleFacts& vehicle);
 
 /// Header line of summary.csv (no newline).
 std::string summary_csv_header();

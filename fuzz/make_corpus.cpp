@@ -275,7 +275,7 @@ void event_log_seeds() {
 
 void file_seeds() {
   const std::string config_dir = AUVRL_CONFIG_DIR;
-  for (const char* v : {"nessie7", "nessie7_munk", "bluerov2_heavy"}) {
+  for (const char* v : {"nessie7", "nessie7_munk", "bluerov2_heavy", "bluerov2"}) {
     write_seed("fuzz_vehicle_yaml", v, file_bytes(config_dir + "/vehicles/" + v + ".yaml"));
   }
   for (const char* p : {"paper", "fast"}) {

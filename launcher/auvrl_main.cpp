@@ -132,6 +132,9 @@ int run_train(int argc, const char* const* argv) {
       "evaluates it and the PID baseline, draws the plots and writes RUN/report.md.");
   cli.option("preset", &preset, "config/presets/NAME.yaml (paper or fast)");
   cli.option("config", &options.config_path, "a configuration file instead of a preset");
+  cli.option("vehicle", &options.vehicle_path,
+             "vehicle file (default: the configuration's vehicle:); every process, the PID, "
+             "the evaluation and the report take the vehicle's facts from it");
   cli.option("run-dir", &options.run_dir, "run directory (default runs/<preset>-<time>)");
   cli.option("resume", &resume_dir, "continue the stopped run in this directory");
   cli.option("actors", &options.actors,
@@ -141,6 +144,8 @@ int run_train(int argc, const char* const* argv) {
   cli.option("finetune-iterations", &options.finetune_iterations,
              "fine-tuning iterations after training (default: finetune.iterations, 0 = none)");
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");
+  cli.option("bin-dir", &options.bin_dir,
+             "where auv_sim, auv_actor, auv_learner and auv_logger are (default: beside auvrl)");
   cli.option("network", &network,
              "private (default: own network namespace) or host (LCM on the host's network)");
   cli.choices("network", {"private", "host"});
@@ -149,6 +154,10 @@ int run_train(int argc, const char* const* argv) {
   auvrl::transport::add_transport_options(cli, cli_transport, &options.transport_args);
   if (!cli.parse(argc, argv)) return 0;
   options.evaluate = !no_eval;
+  if (!resume_dir.empty() && !options.vehicle_path.empty()) {
+    throw auvrl::cli::UsageError("--vehicle names a new run's vehicle; --resume " + resume_dir +
+                                 " continues with the vehicle of its config.yaml");
+  }
   if (!resume_dir.empty()) {
     options.resume = true;
     options.run_dir = resume_dir;

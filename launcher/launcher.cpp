@@ -45,6 +45,7 @@ std::vector<std::string> namespace_command(const TrainOptions& options) {
     pass("--finetune-iterations", std::to_string(options.finetune_iterations));
   }
   if (!options.evaluate) args.push_back("--no-eval");
+  pass("--bin-dir", options.bin_dir);
   args.insert(args.end(), options.transport_args.begin(), options.transport_args.end());
   return args;
 }

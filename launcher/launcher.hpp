@@ -20,6 +20,7 @@ namespace auvrl::launcher {
 /// What `auvrl train` was asked.
 struct TrainOptions {
   std::string config_path;       ///< a preset or configuration file (new runs)
+  std::string vehicle_path;      ///< replaces the configuration's vehicle: (new runs; "": keep)
   std::string run_dir;           ///< the run directory (created for new runs)
   bool resume = false;           ///< continue the run in run_dir
   int actors = -1;               ///< overrides run.actors when >= 0

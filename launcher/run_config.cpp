@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "common/config/table.hpp"
+#include "common/vehicle_facts.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/task/task_yaml.hpp"
 
@@ -31,6 +32,9 @@ config::Table<RunSettings> make_run_table() {
   t.field("restart_window_s", &C::restart_window_s, "s", "see max_restarts");
   t.field("heartbeat_timeout_s", &C::heartbeat_timeout_s, "s, 0: not watched",
           "a process silent this long is taken as hung and restarted");
+  t.field("discard_fault_s", &C::discard_fault_s, "s",
+          "an actor discarding every episode this long (its simulator alive) ends the run")
+      .range(0.1);
   return t;
 }
 
@@ -81,9 +85,7 @@ const config::Table<tuning::FinetuneConfig>& finetune_table() {
 RunConfig read_run_config(const std::string& path) {
   RunConfig c;
   config::Section root = config::load_file(path);
-  std::string vehicle = "../vehicles/nessie7.yaml";
-  root.read("vehicle", vehicle);
-  c.vehicle_path = config::resolve_path(root, vehicle);
+  c.vehicle_path = read_vehicle_path(root);
   task::read_task_config(root.child("task"), c.task);
   config::Section learner = root.child("learner");
   learner.read("max_episodes", c.learner_max_episodes);

@@ -35,6 +35,9 @@ struct RunSettings {
   /// simulator's SIM_HEARTBEAT, the logger's LOGGER_HEARTBEAT, the learner's LEARNER_STATS
   /// (each ~1 Hz) and an actor's EPISODE reports.
   double heartbeat_timeout_s = 60.0;
+  /// An actor whose every episode is discarded (blow-up, simulator timeout) for this long while
+  /// its simulator sends heartbeats ends the run as a fault, s.
+  double discard_fault_s = 10.0;
 };
 
 /// Everything the launcher reads from the run configuration.

@@ -1,12 +1,15 @@
 #include "launcher/run_directory.hpp"
 
+#include <algorithm>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
 
 #include "launcher/launcher.hpp"
 #include "launcher/run_config.hpp"
+#include "sim/vehicle_model.hpp"
 
 namespace auvrl::launcher {
 
@@ -21,20 +24,28 @@ std::string timestamp() {
   return text;
 }
 
-/// Copies the configuration into the run directory with its vehicle path made absolute, so
-/// that the copy resolves the vehicle the same way.
-void copy_config(const std::string& config_path, const fs::path& run_dir) {
+/// Copies the configuration into the run directory with its vehicle made absolute (the one
+/// given by --vehicle, else the file's own), so that every process reads the same vehicle
+/// from the copy.
+void copy_config(const std::string& config_path, const std::string& vehicle_override,
+                 const fs::path& run_dir) {
   std::ifstream in(config_path);
-  std::ofstream out(run_dir / "config.yaml");
-  std::string line;
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
   const RunConfig parsed = read_run_config(config_path);
-  out << "# Copied from " << fs::absolute(config_path).string() << " by auvrl train.\n";
-  while (std::getline(in, line)) {
-    if (line.rfind("vehicle:", 0) == 0) {
-      out << "vehicle: " << fs::absolute(parsed.vehicle_path).lexically_normal().string() << "\n";
-    } else {
-      out << line << "\n";
-    }
+  const std::string vehicle =
+      fs::absolute(vehicle_override.empty() ? parsed.vehicle_path : vehicle_override)
+          .lexically_normal()
+          .string();
+  std::ofstream out(run_dir / "config.yaml");
+  out << "# Copied from " << fs::absolute(config_path).string() << " by auvrl train"
+      << (vehicle_override.empty() ? "" : " --vehicle " + vehicle_override) << ".\n";
+  const bool names_vehicle = std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
+    return l.rfind("vehicle:", 0) == 0;
+  });
+  if (!names_vehicle) out << "vehicle: " << vehicle << "\n";
+  for (const std::string& line : lines) {
+    out << (line.rfind("vehicle:", 0) == 0 ? "vehicle: " + vehicle : line) << "\n";
   }
   if (!out) throw std::runtime_error("cannot write " + run_dir.string() + "/config.yaml");
 }
@@ -82,7 +93,8 @@ std::string prepare_run_directory(TrainOptions& o) {
   for (const char* sub : {"logs", "checkpoints", "eval", "plots", "processes"}) {
     fs::create_directories(fs::path(o.run_dir) / sub);
   }
-  copy_config(o.config_path, o.run_dir);
+  if (!o.vehicle_path.empty()) sim::load_vehicle_file(o.vehicle_path);  // fails here, early
+  copy_config(o.config_path, o.vehicle_path, o.run_dir);
   write_readme(o.run_dir);
   return (fs::path(o.run_dir) / "config.yaml").string();
 }

@@ -1,5 +1,9 @@
 #include "launcher/supervisor.hpp"
 
+#include <fstream>
+
+#include "common/unrecoverable.hpp"
+
 #include <fmt/format.h>
 #include <sys/wait.h>
 
@@ -57,6 +61,20 @@ void Supervisor::add(RoleSpec spec) {
   role->spec = std::move(spec);
   roles_.push_back(std::move(role));
 }
+
+namespace {
+
+/// The last non-empty line of a process's output (what an UnrecoverableFault printed).
+std::string last_line(const std::string& log_path) {
+  std::ifstream in(log_path);
+  std::string line, last = "(no output; see " + log_path + ")";
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+}  // namespace
 
 void Supervisor::start_all() {
   for (auto& role : roles_) start(*role);
@@ -121,6 +139,13 @@ void Supervisor::watch_hang(Role& role, bool anyone_heard) {
 SupervisionOutcome Supervisor::on_exit(Role& role) {
   const int status = role.proc->wait_status();
   const bool clean = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kExitUnrecoverable) {
+    // Another vehicle, other sizes, nothing but discarded episodes: a restart would meet the
+    // same fault. The process's last line says what it met.
+    role.finished = true;
+    return {true, 1, fmt::format("{} stopped: {}", role.spec.name, last_line(role.spec.log_path)),
+            false};
+  }
   if (clean && role.spec.kind == RoleKind::kLearner) {
     role.finished = true;
     return {true, 0, "the learner's schedule ended"};

@@ -95,6 +95,8 @@ struct SupervisionOutcome {
   bool stop = false;        ///< the run must stop
   int exit_code = 0;        ///< its exit code when it stops
   std::string stop_reason;  ///< why (for "auvrl train: <reason>; stopping")
+  /// False when resuming would meet the same fault (another vehicle, other sizes).
+  bool resumable = true;
 };
 
 /// Starts, watches, restarts and stops the roles. Not thread-safe: the signs of life are

@@ -20,6 +20,7 @@
 #include "common/signals.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
+#include "eval/evaluation.hpp"
 #include "launcher/format.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/telemetry.hpp"
@@ -40,8 +41,7 @@ RunContext load_run_context(const TrainOptions& options) {
   ctx.cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   ctx.actors = rc.run.actors > 0 ? rc.run.actors : ctx.cpus;
   ctx.model = sim::load_vehicle_file(rc.vehicle_path);
-  rc.task.num_thrusters = ctx.model.num_thrusters();
-  rc.task.max_thrust_n = ctx.model.thruster_dynamics.max_thrust_n;
+  task::apply_vehicle(ctx.model.facts(), rc.task);
   transport::apply_transport_arguments(options.transport_args, rc.transport);
   const bool dds = rc.transport.kind == transport::TransportKind::kDds;
   if (dds && rc.run.private_lockstep_bus && rc.transport.dds.domain_id + ctx.actors > 232) {
@@ -162,6 +162,15 @@ struct TrainingFigures {
   std::optional<auvrl_lcm::learner_stats_t> last_stats;
   std::int64_t learner_episodes = 0;
   std::map<int, double> sim_steps_per_s;  ///< by simulator process id
+  std::map<int, double> sim_heard_s;      ///< the last heartbeat by simulator process id, s
+  /// Per actor id: since when every episode it reported was discarded (blow-up or simulator
+  /// timeout: nothing sent to the learner), how many, and the last one's end reason.
+  struct Discarding {
+    double since_s = 0;
+    std::int64_t episodes = 0;
+    int last_reason = 0;
+  };
+  std::map<int, Discarding> discarding;
 
   double success_rate() const {
     const auto successes = std::count(recent_success.begin(), recent_success.end(), true);
@@ -198,7 +207,14 @@ class TrainingSession {
   std::optional<std::string> show_progress();
   std::string status_line(double eta_s) const;
   void stop_processes();
-  void print_summary(int exit_code);
+  void print_summary(const SupervisionOutcome& outcome);
+  /// A simulator that serves another vehicle than the run's is a fault (vehicle_fault_).
+  void check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& heartbeat);
+  /// Follows each actor's run of discarded episodes.
+  void note_discarded(const auvrl_lcm::episode_report_t& report);
+  /// An actor that has discarded every episode for run.discard_fault_s while its simulator
+  /// answers heartbeats: the run learns nothing (a hung simulator is the supervisor's).
+  std::optional<std::string> discarding_actor() const;
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -210,6 +226,7 @@ class TrainingSession {
   Supervisor supervisor_;
   TrainingFigures figures_;
   std::unique_ptr<BestPolicyKeeper> best_;
+  std::optional<std::string> vehicle_fault_;
   double start_s_ = clock_.now_s();
   double next_progress_s_ = 0;
   double next_best_eval_s_ = 0;
@@ -229,6 +246,7 @@ void TrainingSession::subscribe() {
         figures_.beta_m = e.beta_m;
         figures_.recent_success.push_back(e.success);
         if (figures_.recent_success.size() > 100) figures_.recent_success.pop_front();
+        note_discarded(e);
         telemetry_.episodes.add(wall_s(), e);
       });
   transport::subscribe<auvrl_lcm::learner_stats_t>(
@@ -244,6 +262,8 @@ void TrainingSession::subscribe() {
       [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
         supervisor_.heard_from_pid(h.pid);
         figures_.sim_steps_per_s[h.pid] = h.steps_per_s;
+        figures_.sim_heard_s[h.pid] = clock_.now_s();
+        check_simulated_vehicle(h);
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
       *transport_, channels::kLoggerHeartbeat,
@@ -325,9 +345,51 @@ std::optional<std::string> TrainingSession::show_progress() {
   return std::nullopt;
 }
 
+void TrainingSession::check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& h) {
+  const VehicleFacts ours = ctx_.model.facts();
+  const VehicleIdentity served{h.vehicle_name, h.num_thrusters,
+                               static_cast<std::uint32_t>(h.vehicle_file_crc32)};
+  if (!same_vehicle(identity_of(ours), served) && !vehicle_fault_) {
+    vehicle_fault_ = vehicle_mismatch_message(
+        "the run", ours, fmt::format("auv_sim (pid {}, {})", h.pid, h.vehicle_file), served);
+  }
+}
+
+void TrainingSession::note_discarded(const auvrl_lcm::episode_report_t& report) {
+  const auto reason = static_cast<task::EndReason>(report.end_reason);
+  if (reason != task::EndReason::kBlowUp && reason != task::EndReason::kSimTimeout) {
+    figures_.discarding.erase(report.actor_id);
+    return;
+  }
+  auto [entry, first] = figures_.discarding.try_emplace(report.actor_id);
+  if (first) entry->second.since_s = clock_.now_s();
+  ++entry->second.episodes;
+  entry->second.last_reason = report.end_reason;
+}
+
+std::optional<std::string> TrainingSession::discarding_actor() const {
+  const double now = clock_.now_s();
+  for (const auto& [actor, run] : figures_.discarding) {
+    if (now - run.since_s < ctx_.rc.run.discard_fault_s) continue;
+    const int sim_pid = supervisor_.pid("sim" + std::to_string(actor));
+    const auto heard = figures_.sim_heard_s.find(sim_pid);
+    if (heard == figures_.sim_heard_s.end() || now - heard->second > 3.0) continue;
+    return fmt::format(
+        "actor{} discarded every episode for {:.0f} s ({} episodes, the last ended by {}) while "
+        "its simulator answers: nothing reaches the learner (see {}/processes/actor{}.log and "
+        "sim{}.log)",
+        actor, now - run.since_s, run.episodes,
+        eval::end_reason_name(static_cast<task::EndReason>(run.last_reason)), ctx_.run_dir, actor,
+        actor);
+  }
+  return std::nullopt;
+}
+
 SupervisionOutcome TrainingSession::supervise_pass() {
   transport_->handle(100);
   if (signals::stop_requested()) return {true, 130, "stopped by the user"};
+  if (vehicle_fault_) return {true, 1, *vehicle_fault_, false};
+  if (auto discarding = discarding_actor()) return {true, 1, *discarding};
   if (ctx_.rc.run.max_train_s > 0 && wall_s() >= ctx_.rc.run.max_train_s) {
     return {true, 0,
             fmt::format("training budget of {} used", format_duration(ctx_.rc.run.max_train_s))};
@@ -352,7 +414,7 @@ void TrainingSession::stop_processes() {
   telemetry_.flush();
 }
 
-void TrainingSession::print_summary(int exit_code) {
+void TrainingSession::print_summary(const SupervisionOutcome& outcome) {
   const fs::path run_dir = ctx_.run_dir;
   std::string best_text;
   if (best_->has_best()) {
@@ -365,7 +427,9 @@ void TrainingSession::print_summary(int exit_code) {
        << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
        << "  policy       " << (run_dir / "policy.nn").string() << best_text << "\n"
        << "  logs         " << (run_dir / "logs").string() << "\n";
-  if (exit_code != 0) out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+  if (outcome.exit_code != 0 && outcome.resumable) {
+    out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
+  }
 }
 
 TrainingResult TrainingSession::run() {
@@ -383,7 +447,7 @@ TrainingResult TrainingSession::run() {
   if (tty_) out_ << "\n";
   out_ << "auvrl train: " << outcome.stop_reason << "; stopping\n";
   stop_processes();
-  print_summary(outcome.exit_code);
+  print_summary(outcome);
   return {outcome.exit_code, std::move(best_)};
 }
 

@@ -5,7 +5,10 @@
 
 #include "common/cli.hpp"
 #include "common/config/table.hpp"
+#include "common/task/task_yaml.hpp"
 #include "common/transport_options.hpp"
+#include "common/unrecoverable.hpp"
+#include "common/vehicle_facts.hpp"
 #include "learner/learner_config.hpp"
 #include "learner/learner_node.hpp"
 #include "learner/learner_process.hpp"
@@ -13,11 +16,14 @@
 int main(int argc, char** argv) {
   using namespace auvrl;
   learner::LearnerNodeConfig config;
-  config.ddpg.state_dim = config.task.state_dim();
-  config.ddpg.action_dim = config.task.num_thrusters;
   std::string config_path = cli::CommandLine::find_value(argc, argv, "config");
+  std::string vehicle_path = default_vehicle_file();
   try {
-    if (!config_path.empty()) learner::read_learner_config_file(config_path, config);
+    if (config_path.empty()) {
+      learner::apply_vehicle_file(vehicle_path, config);
+    } else {
+      learner::read_learner_config_file(config_path, config, &vehicle_path);
+    }
   } catch (const std::exception& e) {
     std::cerr << "auv_learner: " << e.what() << "\n";
     return 2;
@@ -31,9 +37,11 @@ int main(int argc, char** argv) {
                        "of the learner: section is a flag (docs/configuration.md).");
   cmd.option("config", &config_path,
              "run configuration (YAML: task, schedule, learner); the options below override it");
+  cmd.option("vehicle", &vehicle_path,
+             "vehicle file: the networks' sizes follow its thrusters and the task's layout "
+             "(default: the run file's vehicle:, else config/vehicles/nessie7.yaml)");
+  task::task_table().add_flags(cmd, config.task);
   learner::learner_table().add_flags(cmd, config);
-  cmd.option("state-dim", &config.ddpg.state_dim, "observation size (the task's layout)");
-  cmd.option("action-dim", &config.ddpg.action_dim, "action size (thrusters)");
   cmd.option("hidden", &options.hidden, "hidden sizes of both networks, e.g. 400-300");
   cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
   cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
@@ -48,6 +56,7 @@ int main(int argc, char** argv) {
   cmd.option("bench-seconds", &options.bench_seconds, "measuring time per benchmark case");
   try {
     if (!cmd.parse(argc, argv)) return 0;
+    learner::apply_vehicle_file(vehicle_path, config);  // after the task's flags (layout)
     learner::finish_learner_config(options, config);
   } catch (const std::exception& e) {
     std::cerr << "auv_learner: " << e.what() << "\n";
@@ -57,6 +66,9 @@ int main(int argc, char** argv) {
   try {
     if (options.bench) return learner::run_learner_bench(config, options, std::cout);
     learner::run_learner_process(config, options, transport_config, std::cerr);
+  } catch (const UnrecoverableFault& e) {
+    std::cerr << "auv_learner: " << e.what() << "\n";
+    return kExitUnrecoverable;
   } catch (const std::exception& e) {
     std::cerr << "auv_learner: " << e.what() << "\n";
     return 1;

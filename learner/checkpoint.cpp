@@ -1,5 +1,9 @@
 #include "learner/checkpoint.hpp"
 
+#include <optional>
+
+#include "common/unrecoverable.hpp"
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -67,6 +71,7 @@ CheckpointFile restore_latest_checkpoint(const std::string& dir,
                                          std::ostream& log) {
   const auto all = list_checkpoints(dir);
   if (all.empty()) throw std::runtime_error("no checkpoint-*.ckpt in " + dir);
+  std::optional<UnrecoverableFault> other_learner;
   for (const CheckpointFile& file : all) {
     try {
       std::ifstream in(file.path, std::ios::binary);
@@ -75,10 +80,15 @@ CheckpointFile restore_latest_checkpoint(const std::string& dir,
       nn::Reader reader(source, file.path);
       restore(reader);
       return file;
+    } catch (const UnrecoverableFault& e) {
+      log << "checkpoint " << file.path << " is another learner's: " << e.what() << "\n";
+      if (!other_learner) other_learner = e;
     } catch (const std::exception& e) {
       log << "checkpoint " << file.path << " is unusable: " << e.what() << "\n";
     }
   }
+  // Nothing usable, and the newest sound one belongs to a learner of other sizes: say so.
+  if (other_learner) throw *other_learner;
   throw std::runtime_error("no usable checkpoint in " + dir + " (" + std::to_string(all.size()) +
                            " damaged)");
 }

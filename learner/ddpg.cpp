@@ -8,6 +8,8 @@
 
 #include "learner/ddpg.hpp"
 
+#include "common/unrecoverable.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -283,16 +285,18 @@ void Ddpg::restore(nn::Reader& r) {
       state_dim != static_cast<std::uint32_t>(config_.state_dim) ||
       action_dim != static_cast<std::uint32_t>(config_.action_dim) ||
       num_critics != critics_.size()) {
-    r.fail(std::string("saved by a learner with algo ") +
-           (algo == 1   ? "td3"
-            : algo == 0 ? "ddpg"
-                        : "?") +
-           ", state_dim " + std::to_string(state_dim) + ", action_dim " +
-           std::to_string(action_dim) + ", " + std::to_string(num_critics) +
-           " critic(s); expected algo " + to_string(config_.algo) + ", state_dim " +
-           std::to_string(config_.state_dim) + ", action_dim " +
-           std::to_string(config_.action_dim) + ", " + std::to_string(critics_.size()) +
-           " critic(s)");
+    // Sound bytes of another learner (another vehicle, layout or algorithm): no restart
+    // mends that, unlike damage.
+    throw UnrecoverableFault(
+        r.context() + ": saved by a learner with algo " +
+        (algo == 1   ? "td3"
+         : algo == 0 ? "ddpg"
+                     : "?") +
+        ", state_dim " + std::to_string(state_dim) + ", action_dim " +
+        std::to_string(action_dim) + ", " + std::to_string(num_critics) +
+        " critic(s); this learner has algo " + to_string(config_.algo) + ", state_dim " +
+        std::to_string(config_.state_dim) + ", action_dim " + std::to_string(config_.action_dim) +
+        ", " + std::to_string(critics_.size()) + " critic(s)");
   }
   const std::uint64_t updates = r.u64();
   const std::uint64_t actor_updates = r.u64();

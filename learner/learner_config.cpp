@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include "common/config/table.hpp"
+#include "common/vehicle_facts.hpp"
+#include "sim/vehicle_model.hpp"
 #include "common/task/task_yaml.hpp"
 
 namespace auvrl::learner {
@@ -98,12 +100,21 @@ void read_learner_section(config::Section s, LearnerNodeConfig& c) {
   }
 }
 
-void read_learner_config_file(const std::string& path, LearnerNodeConfig& c) {
-  config::Section root = config::load_file(path);
-  task::read_task_config(root.child("task"), c.task);
-  c.schedule = task::read_goal_schedule(root.child("schedule"), c.schedule);
+void apply_vehicle_file(const std::string& vehicle_path, LearnerNodeConfig& c) {
+  c.vehicle = sim::load_vehicle_file(vehicle_path).facts();
+  task::apply_vehicle(c.vehicle, c.task);
   c.ddpg.state_dim = c.task.state_dim();
   c.ddpg.action_dim = c.task.num_thrusters;
+}
+
+void read_learner_config_file(const std::string& path, LearnerNodeConfig& c,
+                              std::string* vehicle_path) {
+  config::Section root = config::load_file(path);
+  const std::string vehicle = read_vehicle_path(root);
+  if (vehicle_path) *vehicle_path = vehicle;
+  task::read_task_config(root.child("task"), c.task);
+  c.schedule = task::read_goal_schedule(root.child("schedule"), c.schedule);
+  apply_vehicle_file(vehicle, c);
   read_learner_section(root.child("learner"), c);
   config::finish_run_file(root);
 }

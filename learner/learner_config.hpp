@@ -13,8 +13,14 @@ namespace auvrl::learner {
 /// LearnerNodeConfig members). Throws config::ConfigError naming file and key.
 void read_learner_section(config::Section section, LearnerNodeConfig& config);
 
-/// Reads task, schedule and learner from a run file into `config`; state and action sizes
-/// come from the task.
-void read_learner_config_file(const std::string& path, LearnerNodeConfig& config);
+/// Loads the vehicle file's facts into `config` (vehicle, the task's thruster fields) and sizes
+/// the networks from the task's layout and the thruster count. Throws sim::VehicleFileError.
+void apply_vehicle_file(const std::string& vehicle_path, LearnerNodeConfig& config);
+
+/// Reads task, schedule and learner from a run file into `config`, and the run file's vehicle
+/// (apply_vehicle_file; its path to `vehicle_path` when given): state and action sizes come
+/// from the task's layout and the vehicle's thrusters.
+void read_learner_config_file(const std::string& path, LearnerNodeConfig& config,
+                              std::string* vehicle_path = nullptr);
 
 }  // namespace auvrl::learner

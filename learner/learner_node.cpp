@@ -1,5 +1,9 @@
 #include "learner/learner_node.hpp"
 
+#include <fmt/format.h>
+
+#include "common/unrecoverable.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -113,6 +117,22 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
            std::all_of(rows.begin(), rows.end(),
                        [cols](const auto& r) { return static_cast<int>(r.size()) == cols; });
   };
+  const bool well_formed = n >= 1 && n <= config_.max_transitions_per_batch &&
+                           msg.state_dim >= 1 && msg.action_dim >= 1 &&
+                           rows_ok(msg.states, msg.state_dim) &&
+                           rows_ok(msg.actions, msg.action_dim);
+  if (well_formed &&
+      (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim) &&
+      unrecoverable_.empty()) {
+    // Sound experience of other sizes: an actor of another vehicle or layout. Counted below as
+    // dropped; poll() stops the learner with this message.
+    unrecoverable_ = fmt::format(
+        "experience from actor {} has state {} and action {} values; this learner's networks "
+        "take state {} and action {} (vehicle {}, {} layout): the actor serves another vehicle "
+        "or layout",
+        msg.actor_id, msg.state_dim, msg.action_dim, config_.ddpg.state_dim,
+        config_.ddpg.action_dim, describe(config_.vehicle), task::to_string(config_.task.layout));
+  }
   if (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim ||
       n < 1 || n > config_.max_transitions_per_batch || !rows_ok(msg.states, msg.state_dim) ||
       !rows_ok(msg.next_states, msg.state_dim) || !rows_ok(msg.actions, msg.action_dim) ||
@@ -302,6 +322,7 @@ void LearnerNode::publish_stats() {
 void LearnerNode::poll(int timeout_ms) {
   const bool can_update = update_credit_ >= 1.0 && !training_done();
   transport_.handle(can_update || broadcast_requested_ ? 0 : timeout_ms);
+  if (!unrecoverable_.empty()) throw UnrecoverableFault(unrecoverable_);
   run_updates();
   maybe_publish_weights();  // requests, and weights held back by the rate limit
   const auto now = Clock::now();

@@ -53,6 +53,9 @@ struct LearnerNodeConfig {
   /// needs `task` to be the actors' task configuration.
   bool her = false;
   int her_k = 4;  ///< future goals per real one
+  /// The vehicle (its file's facts, applied to task): named in the messages about experience
+  /// or checkpoints of other sizes.
+  VehicleFacts vehicle;
   task::TaskConfig task;
   std::int64_t max_episodes = 0;  ///< training ends after this many episodes (0: never)
   std::int64_t max_updates = 0;   ///< or after this many updates (0: never)
@@ -135,6 +138,8 @@ class LearnerNode {
   nn::Rng sample_rng_;  ///< minibatches when relabelling (otherwise the algorithm samples)
   Batch batch_;
   LearnerCounters counters_;
+  /// Experience of other dimensions (set in the transport's callback, thrown by poll()).
+  std::string unrecoverable_;
   transport::DecodeStats decode_stats_;
   std::vector<transport::SubscriptionId> subscriptions_;
   std::vector<std::int64_t> last_batch_seq_;  ///< per actor, -1: none yet

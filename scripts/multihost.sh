@@ -206,7 +206,7 @@ for n in A B C; do
   start "probe$n" "$n" "$bin/multihost_probe" --label "$n" --out "$out/probe$n.txt" "${common[@]}"
 done
 start learner B "$bin/auv_learner" "${common[@]}" --algo td3 --hidden "$hidden" --batch-size 64 \
-  --state-dim 23 --replay-capacity 100000 --updates-per-transition 0.25 --warmup-transitions 500
+  --layout extended --replay-capacity 100000 --updates-per-transition 0.25 --warmup-transitions 500
 start logger C "$bin/auv_logger" "${common[@]}" --dir "$out/logs" --heartbeat-period 0.5 \
   --channels 'EXPERIENCE|EPISODE|POLICY_.*|LEARNER_STATS|SIM_HEARTBEAT'
 start simA A "$bin/auv_sim" "${common[@]}" "${lockstep_a[@]}" --vehicles 1 --first-vehicle-id 0

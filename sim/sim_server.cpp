@@ -86,8 +86,8 @@ std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, i
   return "";
 }
 
-void state_message_from_measurement(const Measurement& measurement, const VehicleState& state,
-                                    int vehicle_id, std::int64_t seq,
+void state_message_from_measurement(const VehicleModel& model, const Measurement& measurement,
+                                    const VehicleState& state, int vehicle_id, std::int64_t seq,
                                     auvrl_lcm::vehicle_state_t& out) {
   out.utime = transport::now_utime();
   out.vehicle_id = vehicle_id;
@@ -101,6 +101,8 @@ void state_message_from_measurement(const Measurement& measurement, const Vehicl
     out.angular_rate_body_rad_s[i] = measurement.nu[3 + i];
     out.current_ned_mps[i] = state.current_velocity_ned_mps[i];
   }
+  out.vehicle_name = model.name;
+  out.vehicle_file_crc32 = static_cast<std::int32_t>(model.file_crc32);
   out.num_thrusters = static_cast<std::int8_t>(measurement.thrust_realised_n.size());
   out.thrust_realised_n.assign(measurement.thrust_realised_n.data(),
                                measurement.thrust_realised_n.data() + out.num_thrusters);
@@ -266,7 +268,7 @@ void SimServer::step_vehicle(int /*id*/, Vehicle& vehicle, const ThrusterVector&
 
 void SimServer::publish_state(int id, Vehicle& vehicle) {
   const Measurement measurement = measure(model_, vehicle.state);
-  state_message_from_measurement(measurement, vehicle.state, id, vehicle.last_seq, state_msg_);
+  state_message_from_measurement(model_, measurement, vehicle.state, id, vehicle.last_seq, state_msg_);
   const int size = state_msg_.getEncodedSize();
   vehicle.last_state_bytes.resize(static_cast<std::size_t>(size));
   state_msg_.encode(vehicle.last_state_bytes.data(), 0, size);
@@ -312,6 +314,9 @@ void SimServer::publish_heartbeat() {
   hb.utime = transport::now_utime();
   hb.pid = static_cast<std::int32_t>(getpid());
   hb.vehicle_file = config_.vehicle_file;
+  hb.vehicle_name = model_.name;
+  hb.num_thrusters = model_.num_thrusters();
+  hb.vehicle_file_crc32 = static_cast<std::int32_t>(model_.file_crc32);
   hb.num_vehicles = config_.num_vehicles;
   hb.lockstep = config_.lockstep;
   hb.control_step_s = model_.control_step_s;

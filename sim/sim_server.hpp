@@ -51,9 +51,10 @@ struct SimServerCounters {
 std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, int num_thrusters,
                                         ResetSettings& out);
 
-/// Fills a state message from a measurement of vehicle id, answering sequence number seq.
-void state_message_from_measurement(const Measurement& measurement, const VehicleState& state,
-                                    int vehicle_id, std::int64_t seq,
+/// Fills a state message from a measurement of vehicle id of `model`, answering sequence number
+/// seq; the message names the vehicle (name, file CRC-32, thruster count).
+void state_message_from_measurement(const VehicleModel& model, const Measurement& measurement,
+                                    const VehicleState& state, int vehicle_id, std::int64_t seq,
                                     auvrl_lcm::vehicle_state_t& out);
 
 /// Serves the vehicles of one model over a transport.

@@ -48,6 +48,8 @@ class ActorDemonstrations : public ::testing::Test {
   }
   ActorNodeConfig config(double fraction) const {
     ActorNodeConfig c;
+    c.vehicle = model_.facts();
+    task::apply_vehicle(c.vehicle, c.task);
     c.task.layout = task::StateLayout::kExtendedThrust;
     c.task.reward = task::RewardKind::kShaped;
     c.task.max_steps = 150;  // 15 s: the PID reaches most way-points of a smaller box in that

@@ -33,16 +33,27 @@ TEST(FinishActorConfig, ExplicitVehicleIdWins) {
   EXPECT_EQ(config.vehicle_id, 7);
 }
 
-TEST(FinishActorConfig, DemonstrationsNeedTheVehicleFile) {
+TEST(FinishActorConfig, TheVehicleDefaultsToNessieVii) {
   ActorNodeConfig config;
   config.demonstration_fraction = 0.5;
-  EXPECT_THROW(finish_actor_config(ActorProcessOptions{}, config), std::invalid_argument);
+  finish_actor_config(ActorProcessOptions{}, config);
+  EXPECT_EQ(config.vehicle.name, "nessie7");
+  EXPECT_EQ(config.task.num_thrusters, 6);
+  EXPECT_TRUE(config.demonstrator);
 }
 
-TEST(FinishActorConfig, ExpertLabelsNeedTheVehicleFile) {
+TEST(FinishActorConfig, TheVehicleFileDecidesTheTasksThrusters) {
   ActorNodeConfig config;
-  config.expert_labels = true;
-  EXPECT_THROW(finish_actor_config(ActorProcessOptions{}, config), std::invalid_argument);
+  config.task.num_thrusters = 6;  // whatever was there: the vehicle's facts replace it
+  ActorProcessOptions options;
+  options.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/bluerov2_heavy.yaml";
+  finish_actor_config(options, config);
+  EXPECT_EQ(config.vehicle.name, "bluerov2_heavy");
+  EXPECT_EQ(config.vehicle.num_thrusters(), 8);
+  EXPECT_NE(config.vehicle.file_crc32, 0u);
+  EXPECT_EQ(config.task.num_thrusters, 8);
+  EXPECT_DOUBLE_EQ(config.task.max_thrust_n, 40.0);
+  EXPECT_EQ(config.vehicle.source_file, options.vehicle_path);
 }
 
 TEST(FinishActorConfig, BuildsOnlyWhatIsAskedFor) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "agent/vehicle_link.hpp"
+#include "common/unrecoverable.hpp"
 #include "common/transport.hpp"
 #include "sim/sim_server.hpp"
 #include "sim/vehicle_model.hpp"
@@ -68,10 +69,43 @@ TEST(VehicleLink, LockstepLinkSendsThePoseAndVelocityToTheSimulator) {
   sim::SimServerConfig config;
   config.heartbeat_period_s = 3600;
   sim::SimServer server(model, *bus, config);  // answers inside the link's own handle calls
-  std::unique_ptr<VehicleLink> link = make_lockstep_link(*bus, 0, model.num_thrusters());
+  std::unique_ptr<VehicleLink> link = make_lockstep_link(*bus, 0, model.facts());
   expect_starts_moving(*link);
   ASSERT_NE(server.vehicle(0), nullptr);
   EXPECT_EQ(server.vehicle(0)->step_count, 0);  // reset last
+}
+
+TEST(VehicleLink, LockstepLinkRefusesAnotherVehicleNamingBoth) {
+  const sim::VehicleModel served =
+      sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/bluerov2_heavy.yaml");
+  const sim::VehicleModel expected = nessie();
+  std::unique_ptr<transport::Transport> bus = transport::make_in_process_transport();
+  sim::SimServerConfig config;
+  config.heartbeat_period_s = 3600;
+  sim::SimServer server(served, *bus, config);
+  std::unique_ptr<VehicleLink> link = make_lockstep_link(*bus, 0, expected.facts());
+  try {
+    link->reset(EpisodeStart{});
+    FAIL() << "a reset answered by another vehicle was accepted";
+  } catch (const UnrecoverableFault& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'nessie7'"), std::string::npos) << what;
+    EXPECT_NE(what.find("nessie7.yaml: 6 thrusters"), std::string::npos) << what;
+    EXPECT_NE(what.find("'bluerov2_heavy' (8 thrusters"), std::string::npos) << what;
+  }
+}
+
+TEST(VehicleLink, LockstepLinkRefusesTheSameNameFromAnotherFile) {
+  // An edited copy of the file: same name and thrusters, other bytes (another model).
+  sim::VehicleModel served = nessie();
+  served.file_crc32 ^= 1u;
+  const sim::VehicleModel expected = nessie();
+  std::unique_ptr<transport::Transport> bus = transport::make_in_process_transport();
+  sim::SimServerConfig config;
+  config.heartbeat_period_s = 3600;
+  sim::SimServer server(served, *bus, config);
+  std::unique_ptr<VehicleLink> link = make_lockstep_link(*bus, 0, expected.facts());
+  EXPECT_THROW(link->reset(EpisodeStart{}), UnrecoverableFault);
 }
 
 }  // namespace

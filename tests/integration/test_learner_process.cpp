@@ -26,8 +26,10 @@ namespace {
 using namespace auvrl;
 using test_support::ChildProcess;
 
-constexpr int kStateDim = 8;
-constexpr int kActionDim = 2;
+// The learner's sizes for its default vehicle (Nessie VII, 6 thrusters) and the paper's layout:
+// 3 + 3 + 6 + 6 inputs.
+constexpr int kStateDim = 18;
+constexpr int kActionDim = 6;
 constexpr int kBatch = 32;
 
 /// A fake actor: its own LCM instance, sends experience and requests, watches the weights.
@@ -76,10 +78,6 @@ std::vector<std::string> learner_args(const std::string& dir, bool resume) {
   std::vector<std::string> args = {test_support::bin_path("auv_learner"),
                                    "--algo",
                                    "td3",
-                                   "--state-dim",
-                                   std::to_string(kStateDim),
-                                   "--action-dim",
-                                   std::to_string(kActionDim),
                                    "--hidden",
                                    "32-32",
                                    "--batch-size",

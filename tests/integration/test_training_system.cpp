@@ -55,7 +55,7 @@ TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
                    dir + "/sim.log");
   ChildProcess learner(
       with_transport({test_support::bin_path("auv_learner"), "--algo", "td3", "--hidden", "32-32",
-                      "--batch-size", "64", "--state-dim", "23", "--replay-capacity", "100000",
+                      "--batch-size", "64", "--layout", "extended", "--replay-capacity", "100000",
                       "--updates-per-transition", "0.25", "--warmup-transitions", "500"}),
       dir + "/learner.log");
   std::vector<std::unique_ptr<ChildProcess>> actors;

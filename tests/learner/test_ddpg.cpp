@@ -451,7 +451,7 @@ TEST(Ddpg, DamagedOrMismatchedStateIsRejectedAndTheLearnerKept) {
     return std::string("<no exception>");
   };
   Ddpg td3(small_config(Algo::kTd3));
-  EXPECT_NE(message(td3).find("expected algo td3"), std::string::npos) << message(td3);
+  EXPECT_NE(message(td3).find("this learner has algo td3"), std::string::npos) << message(td3);
   DdpgConfig wider = small_config(Algo::kDdpg);
   wider.actor_hidden = {32, 12};
   Ddpg wide(wider);

@@ -1,8 +1,8 @@
 // auv_learner's handling of hostile messages with a valid LCM encoding, in-process (memq):
-// experience with wrong dimensions, NaN/inf, actions or expert labels beyond [-1, 1], malformed
+// malformed experience, NaN/inf, actions or expert labels beyond [-1, 1], malformed
 // expert labels, too many or no transitions, unknown actor ids, and episode reports from unknown
 // actors are dropped and counted; nothing of them reaches the replay buffer, the updates or the
-// schedule.
+// schedule. Sound experience of other sizes (an actor of another vehicle) stops the learner.
 #include <gtest/gtest.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
@@ -11,7 +11,11 @@
 #include <limits>
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "common/channels.hpp"
+#include "common/unrecoverable.hpp"
+#include "sim/vehicle_model.hpp"
 #include "learner/learner_node.hpp"
 #include "synthetic_experience.hpp"
 
@@ -21,9 +25,16 @@ using namespace auvrl;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
+/// Nessie VII's facts as its file gives them.
+VehicleFacts nessie7_facts() {
+  return sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml").facts();
+}
+
 class LearnerNodeInput : public ::testing::Test {
  protected:
   LearnerNodeInput() : transport_(transport::make_in_process_transport()) {
+    config_.vehicle = nessie7_facts();
+    task::apply_vehicle(config_.vehicle, config_.task);
     config_.ddpg.state_dim = config_.task.state_dim();
     config_.ddpg.action_dim = config_.task.num_thrusters;
     config_.ddpg.actor_hidden = {8, 8};
@@ -60,16 +71,39 @@ class LearnerNodeInput : public ::testing::Test {
   std::int64_t seq_ = 0;
 };
 
-TEST_F(LearnerNodeInput, WrongDimensionsAndCountsAreDropped) {
-  const int sd = config_.ddpg.state_dim, ad = config_.ddpg.action_dim;
-  // Consistent arrays, but not the learner's sizes.
-  send(channels::kExperience, test_support::synthetic_experience_batch(1, 1, 5, sd + 1, ad));
-  send(channels::kExperience, test_support::synthetic_experience_batch(1, 2, 5, sd, ad - 1));
+TEST_F(LearnerNodeInput, MalformedDimensionsAndCountsAreDropped) {
+  // (The wire format sizes every row by state_dim and action_dim: rows cannot disagree.)
   send(channels::kExperience, test_support::synthetic_experience_batch(1, 3, 5, 0, 0));
   send(channels::kExperience, batch(0));                                      // no transitions
   send(channels::kExperience, batch(config_.max_transitions_per_batch + 1));  // too many
-  EXPECT_EQ(node_->counters().dropped_dims, 5);
+  EXPECT_EQ(node_->counters().dropped_dims, 3);
   expect_untouched();
+}
+
+TEST_F(LearnerNodeInput, SoundExperienceOfOtherSizesStopsTheLearnerNamingBoth) {
+  // An actor of another vehicle (8 thrusters) or layout: consistent arrays, other sizes.
+  const int sd = config_.ddpg.state_dim, ad = config_.ddpg.action_dim;
+  for (const auto& [state_dim, action_dim] : {std::pair{sd + 1, ad}, std::pair{sd, ad + 2}}) {
+    node_ = std::make_unique<learner::LearnerNode>(config_, *transport_, log_);
+    transport::publish(*transport_, channels::kExperience,
+                       test_support::synthetic_experience_batch(1, 1, 5, state_dim, action_dim));
+    try {
+      node_->poll(0);
+      FAIL() << "experience of state " << state_dim << ", action " << action_dim << " was taken";
+    } catch (const UnrecoverableFault& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(fmt::format("has state {} and action {} values", state_dim,
+                                      action_dim)),
+                std::string::npos)
+          << what;
+      EXPECT_NE(what.find(fmt::format("take state {} and action {}", sd, ad)), std::string::npos)
+          << what;
+      EXPECT_NE(what.find("'nessie7'"), std::string::npos) << what;
+    }
+    transport_->drain();
+    EXPECT_EQ(node_->counters().dropped_dims, 1);
+    expect_untouched();
+  }
 }
 
 TEST_F(LearnerNodeInput, NonFiniteValuesAnywhereAreDropped) {

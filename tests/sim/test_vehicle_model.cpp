@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstddef>
 #include <functional>
+#include <iostream>
 #include <string>
 
 #include "sim_test_util.hpp"  // first: see the note on Eigen warnings there
@@ -81,7 +83,7 @@ TEST(VehicleModel, NessieAllocationHasFiveControllableDof) {
   EXPECT_EQ(bluerov().controlled_axes, (AxisSet{true, true, true, true, true, true}));
 }
 
-TEST(VehicleModel, BlueRov2Loads) {
+TEST(VehicleModel, BlueRov2HeavyLoads) {
   const VehicleModel& m = bluerov();
   EXPECT_EQ(m.name, "bluerov2_heavy");
   EXPECT_EQ(m.num_thrusters(), 8);
@@ -101,6 +103,129 @@ TEST(VehicleModel, BlueRov2Loads) {
   for (const Thruster& t : m.thrusters) EXPECT_NEAR(t.direction_body.norm(), 1.0, 1e-15);
 }
 
+/// Where `what` first occurs in a vehicle file's text outside comments (npos if nowhere): the
+/// files quote keys and values in their comments, which a corruption must not hit.
+std::size_t find_in_data(const std::string& text, const std::string& what) {
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) {
+    const auto line_start = text.rfind('\n', at);
+    const auto begin = line_start == std::string::npos ? 0 : line_start + 1;
+    if (text.find('#', begin) >= at) return at;
+  }
+  return std::string::npos;
+}
+
+// ---- The standard BlueROV2 (six thrusters) and the authority rule. --------------------
+
+const VehicleModel& bluerov2_standard() {
+  static const VehicleModel model = load_vehicle_file(vehicle_path("bluerov2.yaml"));
+  return model;
+}
+
+TEST(VehicleModel, BlueRov2StandardLoads) {
+  const VehicleModel& m = bluerov2_standard();
+  EXPECT_EQ(m.name, "bluerov2");
+  EXPECT_EQ(m.num_thrusters(), 6);
+  // Wu 2018: m = 11.5 kg, W = 112.8 N, B = 114.8 N (2 N positively buoyant), CB 2 cm above
+  // the CG (NED: smaller z is higher).
+  EXPECT_DOUBLE_EQ(m.mass_kg, 11.5);
+  EXPECT_NEAR(m.weight_n, 112.8, 0.05);
+  EXPECT_DOUBLE_EQ(m.buoyancy_n, 114.8);
+  EXPECT_GT(m.buoyancy_n - m.weight_n, 1.5);
+  EXPECT_LT(m.buoyancy_n - m.weight_n, 2.5);
+  EXPECT_NEAR(m.cog_body_m.z() - m.cob_body_m.z(), 0.02, 1e-12);
+  // The horizontal thrusters sit where the Heavy's T1..T4 do in x and y, 1.1 cm below the CG.
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(m.thrusters[i].position_body_m.head<2>(),
+              bluerov().thrusters[i].position_body_m.head<2>())
+        << i;
+    EXPECT_DOUBLE_EQ(m.thrusters[i].position_body_m.z(), 0.011) << i;
+    EXPECT_EQ(m.thrusters[i].direction_body, bluerov().thrusters[i].direction_body) << i;
+  }
+  // Surge, sway, heave, roll and yaw controlled; pitch is only the surge thrusters' depth
+  // (pitch row = 0.011 m x surge row), so it is left to the CB-over-CG moment.
+  EXPECT_EQ(m.controlled_axes, (AxisSet{true, true, true, true, false, true}));
+  EXPECT_EQ(allocation_rank(m.allocation), 5);
+  EXPECT_LT((m.allocation.row(kPitch) - 0.011 * m.allocation.row(kSurge)).cwiseAbs().maxCoeff(),
+            1e-12);
+  // Roll from the two vertical thrusters' 0.109 m arms, heave from their sum.
+  const Vector6 roll = m.allocation * thrusts({0, 0, 0, 0, -1, 1});
+  EXPECT_NEAR(roll(kRoll), 2 * 0.109, 1e-12);
+  EXPECT_LT(roll.head<3>().cwiseAbs().maxCoeff(), 1e-12);
+  const Vector6 heave = m.allocation * thrusts({0, 0, 0, 0, 1, 1});
+  EXPECT_NEAR(heave(kHeave), -2.0, 1e-12);
+  EXPECT_LT(heave.tail<3>().cwiseAbs().maxCoeff(), 1e-12);
+}
+
+/// Loads text as a vehicle file and returns the VehicleFileError it raises (fails if none).
+VehicleFileError load_error(const std::string& text) {
+  TempDir dir;
+  const std::string path = dir.file("v.yaml");
+  write_text(path, text);
+  try {
+    load_vehicle_file(path);
+  } catch (const VehicleFileError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "the vehicle file was accepted";
+  return VehicleFileError(path, "", "");
+}
+
+/// The standard BlueROV2's text with its vertical thrusters turned to push forward.
+std::string bluerov2_without_vertical_thrusters() {
+  std::string text = read_text(vehicle_path("bluerov2.yaml"));
+  const std::string up = "direction_body: [0.0, 0.0, -1.0]";
+  int replaced = 0;
+  for (auto at = find_in_data(text, up); at != std::string::npos;
+       at = find_in_data(text, up), ++replaced) {
+    text.replace(at, up.size(), "direction_body: [1.0, 0.0, 0.0]");
+  }
+  EXPECT_EQ(replaced, 2);
+  return text;
+}
+
+TEST(VehicleAuthority, NoHeaveIsRefusedNamingHeave) {
+  const VehicleFileError e = load_error(bluerov2_without_vertical_thrusters());
+  EXPECT_EQ(e.field(), "thrusters") << e.what();
+  EXPECT_NE(std::string(e.what()).find("no authority in heave:"), std::string::npos) << e.what();
+  std::cout << "[ message  ] " << e.what() << "\n";
+}
+
+/// Points thrusters [first, last) radially: along their position's horizontal projection. Then
+/// r x d has no z component: those thrusters give no yaw moment and no heave force.
+void turn_radial(VehicleModel& model, std::size_t first, std::size_t last) {
+  for (std::size_t i = first; i < last; ++i) {
+    Thruster& t = model.thrusters[i];
+    t.direction_body = Vector3(t.position_body_m.x(), t.position_body_m.y(), 0.0).normalized();
+  }
+}
+
+TEST(VehicleAuthority, NoYawIsRefusedNamingYaw) {
+  VehicleModel model = bluerov2_standard();
+  model.source_file = "in-code";
+  turn_radial(model, 0, 4);  // T1..T4; T5, T6 still push up
+  try {
+    finalize_vehicle_model(model);
+    FAIL() << "a vehicle without yaw authority was accepted";
+  } catch (const VehicleFileError& e) {
+    EXPECT_EQ(e.file(), "in-code");
+    EXPECT_EQ(e.field(), "thrusters") << e.what();
+    EXPECT_NE(std::string(e.what()).find("no authority in yaw:"), std::string::npos) << e.what();
+    std::cout << "[ message  ] " << e.what() << "\n";
+  }
+}
+
+TEST(VehicleAuthority, EveryMissingAxisIsNamed) {
+  VehicleModel model = bluerov2_standard();
+  turn_radial(model, 0, 6);  // every thruster horizontal and radial: surge and sway only
+  try {
+    finalize_vehicle_model(model);
+    FAIL() << "a vehicle without heave and yaw authority was accepted";
+  } catch (const VehicleFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("no authority in heave, yaw:"), std::string::npos)
+        << e.what();
+  }
+}
+
 // ---- Validation: corrupted copies of nessie7.yaml. -------------------------------------
 
 struct Corruption {
@@ -117,7 +242,7 @@ class CorruptedVehicleFile : public ::testing::TestWithParam<Corruption> {};
 TEST_P(CorruptedVehicleFile, NamesTheField) {
   const Corruption& c = GetParam();
   std::string text = read_text(vehicle_path("nessie7.yaml"));
-  const auto at = text.find(c.from);
+  const auto at = find_in_data(text, c.from);
   ASSERT_NE(at, std::string::npos) << "corruption target not found: " << c.from;
   text.replace(at, c.from.size(), c.to);
   TempDir dir;
@@ -185,12 +310,14 @@ INSTANTIATE_TEST_SUITE_P(
                    "hydrodynamics.added_mass_coriolis"},
         Corruption{"both buoyancy and volume", "buoyancy_n: 589.6",
                    "buoyancy_n: 589.6\n  displaced_volume_m3: 0.058", "hydrostatics.buoyancy_n"},
-        Corruption{"no control: all thrusters surge",
-                   "    direction_body: [0.0, 1.0, 0.0]\n  - name: T4_lateral_front\n"
-                   "    position_body_m: [0.530, -0.080, 0.053]\n"
-                   "    direction_body: [0.0, 1.0, 0.0]",
-                   "    direction_body: [1.0, 0.0, 0.0]\n  - name: T4_lateral_front\n"
-                   "    position_body_m: [0.530, -0.080, 0.053]\n"
+        // Surge, heave and yaw are required (controlled_axes): with the vertical thrusters
+        // turned to surge, nothing drives heave.
+        Corruption{"no heave authority: vertical thrusters turned to surge",
+                   "    direction_body: [0.0, 0.0, 1.0]\n  - name: T6_vertical_front\n"
+                   "    position_body_m: [0.435, 0.000, 0.075]\n"
+                   "    direction_body: [0.0, 0.0, 1.0]",
+                   "    direction_body: [1.0, 0.0, 0.0]\n  - name: T6_vertical_front\n"
+                   "    position_body_m: [0.435, 0.000, 0.075]\n"
                    "    direction_body: [1.0, 0.0, 0.0]",
                    "thrusters"},
         Corruption{"negative max thrust", "max_thrust_n: 39.24", "max_thrust_n: -39.24",
@@ -199,7 +326,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(VehicleFileValidation, NearUnitDirectionIsNormalised) {
   std::string text = read_text(vehicle_path("nessie7.yaml"));
   const std::string from = "direction_body: [1.0, 0.0, 0.0]";
-  text.replace(text.find(from), from.size(), "direction_body: [1.004, 0.0, 0.0]");
+  text.replace(find_in_data(text, from), from.size(), "direction_body: [1.004, 0.0, 0.0]");
   TempDir dir;
   write_text(dir.file("v.yaml"), text);
   const VehicleModel m = load_vehicle_file(dir.file("v.yaml"));
