@@ -222,7 +222,8 @@ sim::VehicleModel no_pitch_vehicle() {
   model.file_crc32 = 0;
   model.cob_body_m = Eigen::Vector3d(0.0, 0.0, -0.05);
   model.thrusters.resize(6);
-  for (int i = 0; i < 4; ++i) model.thrusters[static_cast<std::size_t>(i)].position_body_m[2] = 0.02;
+  for (int i = 0; i < 4; ++i)
+    model.thrusters[static_cast<std::size_t>(i)].position_body_m[2] = 0.02;
   model.thrusters[4] = {"T5_starboard_vertical", {0.0, 0.218, 0.0}, {0.0, 0.0, -1.0}};
   model.thrusters[5] = {"T6_port_vertical", {0.0, -0.218, 0.0}, {0.0, 0.0, -1.0}};
   sim::finalize_vehicle_model(model);
