@@ -49,10 +49,11 @@ class PolicyReceiverTest : public ::testing::Test {
     return weights(network(task_.state_dim(), task_.num_thrusters), version);
   }
   /// Applies msg, expects a rejection, and that nothing changed.
-  void expect_rejected(const auvrl_lcm::policy_weights_t& msg, const std::string& why) {
+  void expect_rejected(const auvrl_lcm::policy_weights_t& msg, const std::string& why,
+                       agent::WeightsOutcome outcome = agent::WeightsOutcome::kRejected) {
     std::string error;
     const std::int64_t rejected = receiver_.rejected();
-    EXPECT_EQ(receiver_.apply(msg, error), agent::WeightsOutcome::kRejected) << why;
+    EXPECT_EQ(receiver_.apply(msg, error), outcome) << why;
     EXPECT_FALSE(error.empty()) << why;
     EXPECT_EQ(receiver_.rejected(), rejected + 1) << why;
     EXPECT_EQ(receiver_.version(), 1) << why;
@@ -79,8 +80,11 @@ TEST_F(PolicyReceiverTest, DamagedChecksumIsRejected) {
 }
 
 TEST_F(PolicyReceiverTest, WrongShapesAreRejected) {
-  expect_rejected(weights(network(task_.state_dim() + 1, task_.num_thrusters), 2), "inputs");
-  expect_rejected(weights(network(task_.state_dim(), task_.num_thrusters - 1), 2), "outputs");
+  // A sound network of other sizes: another vehicle's or layout's (the actor stops on it).
+  expect_rejected(weights(network(task_.state_dim() + 1, task_.num_thrusters), 2), "inputs",
+                  agent::WeightsOutcome::kWrongSizes);
+  expect_rejected(weights(network(task_.state_dim(), task_.num_thrusters - 1), 2), "outputs",
+                  agent::WeightsOutcome::kWrongSizes);
   expect_rejected(
       weights(network(task_.state_dim(), task_.num_thrusters, nn::Activation::kIdentity), 2),
       "no tanh output");
