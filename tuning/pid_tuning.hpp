@@ -13,7 +13,8 @@
 // Objective (lower is better), with the weights of PidObjectiveWeights:
 //   mean time to reach [s] + 20 s/m x mean hold error [m] + 500 s x missed fraction
 //   + 0.02 s x mean thrust energy,
-// times and hold errors averaged over the episodes reached, energy over all.
+// times and hold errors averaged over the episodes not missed, energy over all; missed: never
+// within the reach radius, or ended by a flip, leaving the region, a blow-up or a timeout.
 //
 // Search: start from the given gains (the compiled defaults for `auvrl tune-pid`); each
 // iteration multiplies gains_per_step gains, drawn without replacement among those that act on
@@ -37,11 +38,11 @@
 namespace auvrl::tuning {
 
 /// The weights of the PID objective (see the file comment). Why these: the time to reach is
-/// what the PID is compared on; 20 s per metre makes a hold error of 0.05 m (what the
-/// defaults hold on Nessie VII) cost a second, so holding is not traded for a faster arrival
-/// that then wobbles; 500 s for a way-point never reached outweighs any time saved elsewhere
-/// (a miss costs 5 s of mean time when 100 way-points); 0.02 per unit of energy (about 1 s for a
-/// typical 50) only breaks ties in favour of quieter thrusters. The same weights tuned Nessie
+/// what the PID is compared on; 20 s per metre makes a hold error of 0.05 m (the defaults hold
+/// 0.04 m on Nessie VII) cost a second, so holding is not traded for a faster arrival that
+/// then wobbles; 500 s for the missed fraction outweighs any time saved elsewhere (with 100
+/// way-points one miss costs 5 s); 0.02 per unit of energy (about 1 s for a typical 50) only
+/// breaks ties in favour of quieter thrusters. The same weights tuned Nessie
 /// VII's defaults (with a 2 x worst-distance term the evaluation's summary does not carry).
 struct PidObjectiveWeights {
   double time = 1.0;           ///< per s of mean time to reach
@@ -72,8 +73,8 @@ struct PidTuningConfig {
 /// The objective on a set of episodes, and its parts.
 struct PidObjective {
   double value = 0.0;        ///< the weighted sum (see PidObjectiveWeights)
-  double mean_time_s = 0.0;  ///< over the episodes reached; the episode's length if none
-  double mean_hold_m = 0.0;  ///< over the episodes reached; 0 if none
+  double mean_time_s = 0.0;  ///< over the episodes not missed; the episode's length if none
+  double mean_hold_m = 0.0;  ///< over the episodes not missed; 0 if none
   double mean_energy = 0.0;  ///< over all episodes
   int missed = 0;            ///< never within the reach radius, or ended by a failure
   int episodes = 0;
