@@ -454,6 +454,12 @@ std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostrea
   config.suite_episodes = request.suite_episodes;
   config.suite_trajectories = request.suite_trajectories;
   std::unique_ptr<agent::Controller> controller = make_eval_controller(request, model, config);
+  out << "vehicle " << describe(model.facts()) << "\n";
+  if (request.controller == "pid") {
+    const agent::VehiclePidGains gains = agent::pid_gains_for(model);
+    out << "PID gains: "
+        << (gains.from_file ? gains.file : "the compiled defaults (no " + gains.file + ")") << "\n";
+  }
   const std::vector<SummaryRow> rows =
       run_evaluation(model, config, *controller, scenarios, request.out_dir);
   out << format_summary_table(rows);

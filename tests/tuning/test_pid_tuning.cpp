@@ -235,12 +235,14 @@ TEST(CommittedPidGains, ReachWayPointsNearTheVerticalWithAndWithoutTheFault) {
   for (const char* name : {"nessie7", "bluerov2_heavy", "bluerov2"}) {
     const sim::VehicleModel model =
         sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/" + name + ".yaml");
+    // The gains each vehicle's PID uses: the BlueROV2s' files; Nessie VII's compiled defaults
+    // (docs/pid.md says why it has no file).
     const agent::VehiclePidGains gains = agent::pid_gains_for(model);
-    ASSERT_TRUE(gains.from_file) << name << ": no " << gains.file;
+    EXPECT_EQ(gains.from_file, std::string(name) != "nessie7") << name << ": " << gains.file;
     const GridResult g = steep_grid(model, gains.gains);
     EXPECT_EQ(g.missed, 0) << name;
-    EXPECT_LT(g.worst_time_s, 40.0) << name;  // measured 32.2 s (nessie7), 16.1 s, 7.7 s
-    // Short of the task's 1.2 rad flip angle; measured 0.97 rad (nessie7), 0.89, 0.65.
+    EXPECT_LT(g.worst_time_s, 40.0) << name;  // measured 21.0 s (nessie7), 16.1 s, 7.7 s
+    // Short of the task's 1.2 rad flip angle; measured 0.22 rad (nessie7), 0.89, 0.65.
     EXPECT_LT(g.max_tilt_rad, 1.1) << name;
     std::printf("%s: %d way-points, %d missed, worst %.1f s, tilt up to %.2f rad\n", name,
                 g.episodes, g.missed, g.worst_time_s, g.max_tilt_rad);

@@ -97,15 +97,16 @@ TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
   c.hold_weight = 0.0;
   std::vector<FinetuneEpisode> episodes(1);
   episodes[0].goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);  // test1
-  // The vehicle's own gains (config/vehicles/nessie7.pid.yaml), as set_pid_arrivals uses.
+  // The vehicle's own gains (a nessie7.pid.yaml, else the compiled defaults), as
+  // set_pid_arrivals uses.
   agent::PidController pid(nessie(), agent::pid_gains_for(nessie()).gains);
   const double pid_arrival_s = arrival_objective(nessie(), t, pid, episodes[0], c);
   c.pid_lag_weight = 4.0;
   c.pid_lead_s = 0.3;
   set_pid_arrivals(nessie(), t, c, episodes);
   EXPECT_EQ(episodes[0].pid_arrival_s, pid_arrival_s);
-  EXPECT_GT(pid_arrival_s, 8.1);  // measured 8.55 s (8.24 s with the compiled defaults)
-  EXPECT_LT(pid_arrival_s, 8.7);
+  EXPECT_GT(pid_arrival_s, 8.1);  // 8.24 s with the compiled defaults
+  EXPECT_LT(pid_arrival_s, 8.3);
   // The PID itself arrives 0.3 s later than asked: 4 s per s of it.
   EXPECT_NEAR(arrival_objective(nessie(), t, pid, episodes[0], c), pid_arrival_s + 4.0 * 0.3, 1e-9);
   // A lead of -0.5 s lets it be up to 0.5 s later for nothing.
