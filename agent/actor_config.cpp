@@ -1,8 +1,8 @@
 #include "agent/actor_config.hpp"
 
 #include "common/config/table.hpp"
-#include "common/vehicle_facts.hpp"
 #include "common/task/task_yaml.hpp"
+#include "common/vehicle_facts.hpp"
 
 namespace auvrl::agent {
 namespace {

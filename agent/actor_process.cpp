@@ -72,9 +72,9 @@ void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions&
   signals::install_stop_handlers();
   ActorNode node(config, *transport, log, lockstep.get());
   log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << " "
-      << describe(config.vehicle) << ", "
-      << task::to_string(config.task.layout) << " state (" << config.task.state_dim() << "), "
-      << task::to_string(config.task.reward) << " reward, seed " << options.seed << "\n";
+      << describe(config.vehicle) << ", " << task::to_string(config.task.layout) << " state ("
+      << config.task.state_dim() << "), " << task::to_string(config.task.reward) << " reward, seed "
+      << options.seed << "\n";
   run_actor_episodes(node, config, options.report_every, log);
 }
 

@@ -6,7 +6,9 @@
 
 namespace auvrl {
 
-std::string default_vehicle_file() { return std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml"; }
+std::string default_vehicle_file() {
+  return std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+}
 
 std::string read_vehicle_path(config::Section& root) {
   std::string vehicle;
@@ -26,9 +28,10 @@ std::string describe(const VehicleFacts& facts) {
 
 std::string vehicle_mismatch_message(const std::string& who, const VehicleFacts& ours,
                                      const std::string& peer, const VehicleIdentity& theirs) {
-  return fmt::format("{} expects vehicle {} but {} serves vehicle {}: name the same vehicle file "
-                     "for every process (auvrl train --vehicle FILE, or the run file's vehicle:)",
-                     who, describe(ours), peer, describe(theirs));
+  return fmt::format(
+      "{} expects vehicle {} but {} serves vehicle {}: name the same vehicle file "
+      "for every process (auvrl train --vehicle FILE, or the run file's vehicle:)",
+      who, describe(ours), peer, describe(theirs));
 }
 
 }  // namespace auvrl

@@ -1,12 +1,14 @@
 // auv_learner's input: EXPERIENCE, WEIGHTS_REQUEST and EPISODE messages as raw bytes, published
 // on the in-process transport and handled by LearnerNode (the code auv_learner runs): batches
 // go into the replay buffer and hindsight index, updates run, weights are broadcast. Small
-// networks and buffer so that an input runs in microseconds; the paper's state layout.
+// networks and buffer so that an input runs in microseconds; the paper's state layout. Sound
+// experience of other sizes stops the learner (UnrecoverableFault): the input ends there.
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/weights_request_t.hpp>
 
 #include "common/channels.hpp"
+#include "common/unrecoverable.hpp"
 #include "fuzz/fuzz_configs.hpp"
 #include "fuzz/fuzz_util.hpp"
 #include "learner/learner_node.hpp"
@@ -36,7 +38,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
     }
     t.publish(channel, bytes.data(), bytes.size());
-    node.poll(0);
+    try {
+      node.poll(0);
+    } catch (const UnrecoverableFault&) {
+      break;  // sound experience of other sizes: the learner stops, as designed
+    }
   }
   t.drain();
   return 0;

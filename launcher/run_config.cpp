@@ -3,9 +3,9 @@
 #include <stdexcept>
 
 #include "common/config/table.hpp"
-#include "common/vehicle_facts.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/task/task_yaml.hpp"
+#include "common/vehicle_facts.hpp"
 
 namespace auvrl::launcher {
 

@@ -40,9 +40,8 @@ void copy_config(const std::string& config_path, const std::string& vehicle_over
   std::ofstream out(run_dir / "config.yaml");
   out << "# Copied from " << fs::absolute(config_path).string() << " by auvrl train"
       << (vehicle_override.empty() ? "" : " --vehicle " + vehicle_override) << ".\n";
-  const bool names_vehicle = std::any_of(lines.begin(), lines.end(), [](const std::string& l) {
-    return l.rfind("vehicle:", 0) == 0;
-  });
+  const bool names_vehicle = std::any_of(
+      lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("vehicle:", 0) == 0; });
   if (!names_vehicle) out << "vehicle: " << vehicle << "\n";
   for (const std::string& line : lines) {
     out << (line.rfind("vehicle:", 0) == 0 ? "vehicle: " + vehicle : line) << "\n";

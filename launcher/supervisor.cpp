@@ -1,9 +1,5 @@
 #include "launcher/supervisor.hpp"
 
-#include <fstream>
-
-#include "common/unrecoverable.hpp"
-
 #include <fmt/format.h>
 #include <sys/wait.h>
 
@@ -11,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <fstream>
 
 #include "common/process.hpp"
+#include "common/unrecoverable.hpp"
 #include "launcher/format.hpp"
 
 namespace auvrl::launcher {

@@ -1,15 +1,13 @@
 #include "learner/checkpoint.hpp"
 
-#include <optional>
-
-#include "common/unrecoverable.hpp"
-
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include "common/nn/file_io.hpp"
+#include "common/unrecoverable.hpp"
 
 namespace auvrl::learner {
 

@@ -8,14 +8,13 @@
 
 #include "learner/ddpg.hpp"
 
-#include "common/unrecoverable.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
 
 #include "common/nn/serialize.hpp"
+#include "common/unrecoverable.hpp"
 
 namespace auvrl::learner {
 namespace {
@@ -287,16 +286,16 @@ void Ddpg::restore(nn::Reader& r) {
       num_critics != critics_.size()) {
     // Sound bytes of another learner (another vehicle, layout or algorithm): no restart
     // mends that, unlike damage.
-    throw UnrecoverableFault(
-        r.context() + ": saved by a learner with algo " +
-        (algo == 1   ? "td3"
-         : algo == 0 ? "ddpg"
-                     : "?") +
-        ", state_dim " + std::to_string(state_dim) + ", action_dim " +
-        std::to_string(action_dim) + ", " + std::to_string(num_critics) +
-        " critic(s); this learner has algo " + to_string(config_.algo) + ", state_dim " +
-        std::to_string(config_.state_dim) + ", action_dim " + std::to_string(config_.action_dim) +
-        ", " + std::to_string(critics_.size()) + " critic(s)");
+    throw UnrecoverableFault(r.context() + ": saved by a learner with algo " +
+                             (algo == 1   ? "td3"
+                              : algo == 0 ? "ddpg"
+                                          : "?") +
+                             ", state_dim " + std::to_string(state_dim) + ", action_dim " +
+                             std::to_string(action_dim) + ", " + std::to_string(num_critics) +
+                             " critic(s); this learner has algo " + to_string(config_.algo) +
+                             ", state_dim " + std::to_string(config_.state_dim) + ", action_dim " +
+                             std::to_string(config_.action_dim) + ", " +
+                             std::to_string(critics_.size()) + " critic(s)");
   }
   const std::uint64_t updates = r.u64();
   const std::uint64_t actor_updates = r.u64();

@@ -3,9 +3,9 @@
 #include <fmt/format.h>
 
 #include "common/config/table.hpp"
+#include "common/task/task_yaml.hpp"
 #include "common/vehicle_facts.hpp"
 #include "sim/vehicle_model.hpp"
-#include "common/task/task_yaml.hpp"
 
 namespace auvrl::learner {
 namespace {

@@ -1,9 +1,6 @@
 #include "learner/learner_node.hpp"
 
 #include <fmt/format.h>
-
-#include "common/unrecoverable.hpp"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +9,7 @@
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
+#include "common/unrecoverable.hpp"
 #include "learner/checkpoint.hpp"
 
 namespace auvrl::learner {
@@ -105,6 +103,20 @@ bool LearnerNode::training_done() const {
          (config_.max_updates > 0 && ddpg_->updates() >= config_.max_updates);
 }
 
+void LearnerNode::note_other_sizes(const auvrl_lcm::experience_batch_t& msg) {
+  // Sound experience of other sizes (the wire format sizes every row by state_dim and
+  // action_dim) comes from an actor of another vehicle or layout: no restart mends that.
+  // poll() stops the learner with this message; the batch is counted as dropped.
+  if (msg.state_dim < 1 || msg.action_dim < 1 || !unrecoverable_.empty()) return;
+  if (msg.state_dim == config_.ddpg.state_dim && msg.action_dim == config_.ddpg.action_dim) return;
+  unrecoverable_ = fmt::format(
+      "experience from actor {} has state {} and action {} values; this learner's networks "
+      "take state {} and action {} (vehicle {}, {} layout): the actor serves another vehicle "
+      "or layout",
+      msg.actor_id, msg.state_dim, msg.action_dim, config_.ddpg.state_dim, config_.ddpg.action_dim,
+      describe(config_.vehicle), task::to_string(config_.task.layout));
+}
+
 void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
   ++counters_.batches_received;
   if (msg.actor_id < 0 || msg.actor_id >= config_.max_actors) {
@@ -117,22 +129,7 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
            std::all_of(rows.begin(), rows.end(),
                        [cols](const auto& r) { return static_cast<int>(r.size()) == cols; });
   };
-  const bool well_formed = n >= 1 && n <= config_.max_transitions_per_batch &&
-                           msg.state_dim >= 1 && msg.action_dim >= 1 &&
-                           rows_ok(msg.states, msg.state_dim) &&
-                           rows_ok(msg.actions, msg.action_dim);
-  if (well_formed &&
-      (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim) &&
-      unrecoverable_.empty()) {
-    // Sound experience of other sizes: an actor of another vehicle or layout. Counted below as
-    // dropped; poll() stops the learner with this message.
-    unrecoverable_ = fmt::format(
-        "experience from actor {} has state {} and action {} values; this learner's networks "
-        "take state {} and action {} (vehicle {}, {} layout): the actor serves another vehicle "
-        "or layout",
-        msg.actor_id, msg.state_dim, msg.action_dim, config_.ddpg.state_dim,
-        config_.ddpg.action_dim, describe(config_.vehicle), task::to_string(config_.task.layout));
-  }
+  if (n >= 1 && n <= config_.max_transitions_per_batch) note_other_sizes(msg);
   if (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim ||
       n < 1 || n > config_.max_transitions_per_batch || !rows_ok(msg.states, msg.state_dim) ||
       !rows_ok(msg.next_states, msg.state_dim) || !rows_ok(msg.actions, msg.action_dim) ||

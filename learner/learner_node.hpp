@@ -119,6 +119,8 @@ class LearnerNode {
   auvrl_lcm::policy_weights_t weights_message() const;
 
  private:
+  /// Sets unrecoverable_ when a sound batch has other sizes than the networks.
+  void note_other_sizes(const auvrl_lcm::experience_batch_t& msg);
   void on_experience(const auvrl_lcm::experience_batch_t& msg);
   void on_weights_request(const auvrl_lcm::weights_request_t& msg);
   void on_episode(const auvrl_lcm::episode_report_t& msg);

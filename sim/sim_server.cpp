@@ -268,7 +268,8 @@ void SimServer::step_vehicle(int /*id*/, Vehicle& vehicle, const ThrusterVector&
 
 void SimServer::publish_state(int id, Vehicle& vehicle) {
   const Measurement measurement = measure(model_, vehicle.state);
-  state_message_from_measurement(model_, measurement, vehicle.state, id, vehicle.last_seq, state_msg_);
+  state_message_from_measurement(model_, measurement, vehicle.state, id, vehicle.last_seq,
+                                 state_msg_);
   const int size = state_msg_.getEncodedSize();
   vehicle.last_state_bytes.resize(static_cast<std::size_t>(size));
   state_msg_.encode(vehicle.last_state_bytes.data(), 0, size);

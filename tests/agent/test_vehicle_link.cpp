@@ -7,8 +7,8 @@
 #include <string>
 
 #include "agent/vehicle_link.hpp"
-#include "common/unrecoverable.hpp"
 #include "common/transport.hpp"
+#include "common/unrecoverable.hpp"
 #include "sim/sim_server.hpp"
 #include "sim/vehicle_model.hpp"
 

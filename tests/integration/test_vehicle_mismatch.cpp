@@ -44,10 +44,10 @@ std::string bin_dir_wrapping(const std::string& tmp, const std::string& wrapped,
 
 /// How an auvrl train run ended.
 struct Ending {
-  int status = -1;               ///< wait status (-1: still running at the deadline)
-  double stopping_s = -1;        ///< when "...; stopping" appeared, s after the start
-  double exited_s = -1;          ///< when the launcher exited, s after the start
-  std::string stop_line;         ///< the "auvrl train: <reason>; stopping" line
+  int status = -1;         ///< wait status (-1: still running at the deadline)
+  double stopping_s = -1;  ///< when "...; stopping" appeared, s after the start
+  double exited_s = -1;    ///< when the launcher exited, s after the start
+  std::string stop_line;   ///< the "auvrl train: <reason>; stopping" line
   std::string log;
 };
 
@@ -127,10 +127,12 @@ TEST(VehicleMismatch, ALearnerOfOtherDimensionsStopsTheRunNamingBoth) {
   expect_failed_promptly(e);
   // The learner (experience of 29 inputs) or an actor (weights of 23) says it first.
   const bool learner_saw =
-      e.stop_line.find("has state 29 and action 6 values; this learner's networks take state "
-                       "23 and action 6") != std::string::npos;
-  const bool actor_saw = e.stop_line.find("in=23") != std::string::npos &&
-                         e.stop_line.find("this actor's task needs in=29 out=6") != std::string::npos;
+      e.stop_line.find(
+          "has state 29 and action 6 values; this learner's networks take state "
+          "23 and action 6") != std::string::npos;
+  const bool actor_saw =
+      e.stop_line.find("in=23") != std::string::npos &&
+      e.stop_line.find("this actor's task needs in=29 out=6") != std::string::npos;
   EXPECT_TRUE(learner_saw || actor_saw) << e.log;
   EXPECT_NE(e.stop_line.find("'nessie7'"), std::string::npos) << e.log;
   EXPECT_LT(e.exited_s, 30.0) << e.log;
@@ -161,11 +163,11 @@ TEST(VehicleMismatch, AnActorThatDiscardsEveryEpisodeStopsTheRun) {
 
 TEST(VehicleMismatch, APolicyOfOtherSizesIsRefusedNamingFileAndVehicle) {
   const std::string tmp = test_support::make_temp_dir("auvrl_mismatch_policy_");
-  ChildProcess eval({test_support::bin_path("auvrl"), "eval", "--policy",
-                     kConfigDir + "/policies/fast.nn", "--vehicle",
-                     kConfigDir + "/vehicles/bluerov2_heavy.yaml", "--scenario", "test1", "--out",
-                     tmp + "/eval"},
-                    tmp + "/eval.log");
+  ChildProcess eval(
+      {test_support::bin_path("auvrl"), "eval", "--policy", kConfigDir + "/policies/fast.nn",
+       "--vehicle", kConfigDir + "/vehicles/bluerov2_heavy.yaml", "--scenario", "test1", "--out",
+       tmp + "/eval"},
+      tmp + "/eval.log");
   const int status = eval.wait_for_exit(std::chrono::seconds(30));
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0) << eval.log();
   EXPECT_NE(eval.log().find("policies/fast.nn (vehicle bluerov2_heavy): a policy with 29 inputs "
@@ -186,10 +188,10 @@ TEST(VehicleMismatch, ACheckpointOfOtherSizesStopsTheLearnerNamingBoth) {
     ASSERT_EQ(learner.terminate(), 0) << learner.log();
   }
   const auto start = Clock::now();
-  ChildProcess learner({test_support::bin_path("auv_learner"), "--checkpoint-dir", checkpoints,
-                        "--hidden", "16-16", "--resume", "--vehicle",
-                        kConfigDir + "/vehicles/bluerov2_heavy.yaml"},
-                       tmp + "/second.log");
+  ChildProcess learner(
+      {test_support::bin_path("auv_learner"), "--checkpoint-dir", checkpoints, "--hidden", "16-16",
+       "--resume", "--vehicle", kConfigDir + "/vehicles/bluerov2_heavy.yaml"},
+      tmp + "/second.log");
   const int status = learner.wait_for_exit(std::chrono::seconds(20));
   const double stopped_s = std::chrono::duration<double>(Clock::now() - start).count();
   std::cout << "[ figures  ] the learner stopped " << stopped_s << " s after its start\n";

@@ -3,6 +3,7 @@
 // expert labels, too many or no transitions, unknown actor ids, and episode reports from unknown
 // actors are dropped and counted; nothing of them reaches the replay buffer, the updates or the
 // schedule. Sound experience of other sizes (an actor of another vehicle) stops the learner.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
@@ -11,12 +12,10 @@
 #include <limits>
 #include <sstream>
 
-#include <fmt/format.h>
-
 #include "common/channels.hpp"
 #include "common/unrecoverable.hpp"
-#include "sim/vehicle_model.hpp"
 #include "learner/learner_node.hpp"
+#include "sim/vehicle_model.hpp"
 #include "synthetic_experience.hpp"
 
 namespace {
@@ -92,8 +91,7 @@ TEST_F(LearnerNodeInput, SoundExperienceOfOtherSizesStopsTheLearnerNamingBoth) {
       FAIL() << "experience of state " << state_dim << ", action " << action_dim << " was taken";
     } catch (const UnrecoverableFault& e) {
       const std::string what = e.what();
-      EXPECT_NE(what.find(fmt::format("has state {} and action {} values", state_dim,
-                                      action_dim)),
+      EXPECT_NE(what.find(fmt::format("has state {} and action {} values", state_dim, action_dim)),
                 std::string::npos)
           << what;
       EXPECT_NE(what.find(fmt::format("take state {} and action {}", sd, ad)), std::string::npos)
