@@ -21,6 +21,7 @@ import datetime
 import math
 import os
 import sys
+import textwrap
 import traceback
 
 import matplotlib
@@ -561,6 +562,8 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
     if nthr == 0:
         NOTES.damage(f"{scenario}: trajectories have no thrust_i columns; no thruster plot")
         return names
+    # The thrusters' names from the evaluation's vehicle.csv (T1, T2, ... without it).
+    thruster_names = panels[0][0].thruster_names
     fig, axes = plt.subplots(nthr, ncol, figsize=(max(8.0, 6.0 * ncol),
                                                   1.35 * nthr + 1.2 + extra),
                              squeeze=False, sharex=True, sharey=True)
@@ -577,10 +580,11 @@ def plot_scenario(ctrls, scenario, plots_dir, written):
                 ax.axvline(t_reach, color="black", ls=":", lw=1.0)
             ax.grid(True, alpha=0.4)
             ax.axhline(0, color="black", lw=0.5)
-            names = panels[0][0].thruster_names
-            label = names[i].replace("_", " ") if len(names) == nthr else f"T{i + 1}"
+            named = len(thruster_names) == nthr
+            label = textwrap.fill(thruster_names[i].replace("_", " "), 12) if named \
+                else f"T{i + 1}"
             if k == 0:
-                ax.set_ylabel(f"{label}\n[N]", fontsize=8)
+                ax.set_ylabel(f"{label}\n[N]", fontsize=7 if named else 8)
             if real is not None and cmd is not None:
                 pc, pr = np.nanmax(np.abs(cmd)), np.nanmax(np.abs(real))
                 if pc > 1.0 and pr < 0.5 * pc:
