@@ -30,6 +30,8 @@ inline const std::string kLearnerStats = "LEARNER_STATS";
 inline const std::string kEpisode = "EPISODE";
 /// auv_logger's heartbeat (logger_heartbeat_t).
 inline const std::string kLoggerHeartbeat = "LOGGER_HEARTBEAT";
+/// auv_controller's mission progress and safety state (mission_status_t).
+inline const std::string kMissionStatus = "MISSION_STATUS";
 
 /// Regexes auv_sim subscribes to (all vehicle ids; the id is parsed and checked).
 inline const std::string kSimCommandPattern = "SIM_CMD_[0-9]+";
