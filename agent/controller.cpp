@@ -2,6 +2,9 @@
 
 #include <stdexcept>
 
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
+
 namespace auvrl::agent {
 
 namespace {
@@ -29,6 +32,45 @@ void PolicyController::set_network(nn::Mlp network) {
 void PolicyController::act(const task::Observation&, const Eigen::Vector3d&,
                            const task::StateVector& state, task::ActionVector& action) {
   action = network_.forward(state);
+}
+
+namespace {
+
+nn::Mlp read_policy_network(const std::string& path) {
+  std::vector<std::uint8_t> bytes;
+  try {
+    bytes = nn::read_file(path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("policy file (--policy): ") + e.what());
+  }
+  try {
+    return nn::network_from_bytes(bytes, 1);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("policy file " + path + ": not a usable network file: " + e.what());
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<PolicyController> load_policy(const std::string& path,
+                                              const std::string& vehicle_name, int num_thrusters,
+                                              const std::optional<task::StateLayout>& layout,
+                                              task::TaskConfig& task) {
+  nn::Mlp network = read_policy_network(path);
+  const std::string where = "policy file " + path + " (vehicle " + vehicle_name + ")";
+  task.num_thrusters = num_thrusters;
+  try {
+    task.layout = layout ? *layout : task::infer_layout(network.spec().input_dim, num_thrusters);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + ": " + e.what());
+  }
+  try {
+    return std::make_unique<PolicyController>(std::move(network), task.state_dim(),
+                                              num_thrusters);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(where + " with the " + task::to_string(task.layout) +
+                             " layout: " + e.what());
+  }
 }
 
 }  // namespace auvrl::agent

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/nn/mlp.hpp"
@@ -40,5 +41,14 @@ class PolicyController final : public Controller {
   int state_dim_;
   int num_thrusters_;
 };
+
+/// The policy in a network file, for a vehicle with num_thrusters thrusters: reads the file
+/// (its CRC-32 checked), takes `layout` or infers it from the network's input size
+/// (task::infer_layout), checks the sizes and sets task.layout. Throws std::runtime_error
+/// naming the file, the vehicle and what was expected.
+std::unique_ptr<PolicyController> load_policy(const std::string& path,
+                                              const std::string& vehicle_name, int num_thrusters,
+                                              const std::optional<task::StateLayout>& layout,
+                                              task::TaskConfig& task);
 
 }  // namespace auvrl::agent

@@ -21,8 +21,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 /// Offsets of the fixed parts of the two layouts (see common/task/task.hpp).
-constexpr int kPaperFixedInputs = 12;
-constexpr int kExtendedFixedInputs = 17;
 
 const Scenario kAllScenarios[] = {Scenario::kTest1, Scenario::kTest2, Scenario::kFault,
                                   Scenario::kCurrent, Scenario::kSuite};
@@ -379,20 +377,6 @@ std::string format_summary_table(const std::vector<SummaryRow>& rows) {
   return out;
 }
 
-task::StateLayout infer_layout(int input_dim, int num_thrusters) {
-  if (input_dim == kPaperFixedInputs + num_thrusters) return task::StateLayout::kPaper;
-  if (input_dim == kExtendedFixedInputs + num_thrusters) return task::StateLayout::kExtended;
-  if (input_dim == kExtendedFixedInputs + 2 * num_thrusters) {
-    return task::StateLayout::kExtendedThrust;
-  }
-  throw std::invalid_argument(
-      "a policy with " + std::to_string(input_dim) + " inputs fits no state layout for " +
-      std::to_string(num_thrusters) + " thrusters: expected " +
-      std::to_string(kPaperFixedInputs + num_thrusters) + " (paper), " +
-      std::to_string(kExtendedFixedInputs + num_thrusters) + " (extended) or " +
-      std::to_string(kExtendedFixedInputs + 2 * num_thrusters) + " (extended_thrust)");
-}
-
 std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& request,
                                                         const sim::VehicleModel& model,
                                                         EvaluationConfig& config) {
@@ -412,35 +396,9 @@ std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& reque
   if (request.policy_path.empty()) {
     throw std::invalid_argument("--policy FILE is required (or --controller pid)");
   }
-  nn::Mlp network = [&] {
-    std::vector<std::uint8_t> bytes;
-    try {
-      bytes = nn::read_file(request.policy_path);
-    } catch (const std::exception& e) {
-      throw std::runtime_error(std::string("policy file (--policy): ") + e.what());
-    }
-    try {
-      return nn::network_from_bytes(bytes, 1);
-    } catch (const std::exception& e) {
-      throw std::runtime_error("policy file " + request.policy_path +
-                               ": not a usable network file: " + e.what());
-    }
-  }();
-  const std::string where = "policy file " + request.policy_path + " (vehicle " + model.name + ")";
-  if (request.layout.empty()) {
-    try {
-      config.task.layout = infer_layout(network.spec().input_dim, n);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(where + ": " + e.what());
-    }
-  }
-  try {
-    return std::make_unique<agent::PolicyController>(std::move(network), config.task.state_dim(),
-                                                     n);
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(where + " with the " + task::to_string(config.task.layout) +
-                             " layout: " + e.what());
-  }
+  std::optional<task::StateLayout> layout;
+  if (!request.layout.empty()) layout = config.task.layout;
+  return agent::load_policy(request.policy_path, model.name, n, layout, config.task);
 }
 
 std::vector<SummaryRow> run_eval_request(const EvalRequest& request, std::ostream& out) {

@@ -153,10 +153,8 @@ void write_trajectory_csv(const std::string& path, const std::vector<agent::Traj
 /// hold error over the reached episodes, mean final error and mean thrust energy.
 std::string format_summary_table(const std::vector<SummaryRow>& rows);
 
-/// The state layout a policy network was trained with, from its input size: 12 + n is the
-/// paper's layout (18 with six thrusters), 17 + n the extended one (23), 17 + 2n the extended
-/// one with the thrusters' realised thrust (29). Throws std::invalid_argument otherwise.
-task::StateLayout infer_layout(int input_dim, int num_thrusters);
+/// The state layout of a policy network (task::infer_layout).
+using task::infer_layout;
 
 /// What `auvrl eval` was asked to do.
 struct EvalRequest {

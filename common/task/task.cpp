@@ -271,4 +271,20 @@ void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task) {
   task.control_step_s = vehicle.control_step_s;
 }
 
+StateLayout infer_layout(int input_dim, int num_thrusters) {
+  std::string expected;
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
+    TaskConfig sized;
+    sized.layout = layout;
+    sized.num_thrusters = num_thrusters;
+    if (input_dim == sized.state_dim()) return layout;
+    expected += (expected.empty() ? "" : layout == StateLayout::kExtendedThrust ? " or " : ", ") +
+                std::to_string(sized.state_dim()) + " (" + to_string(layout) + ")";
+  }
+  throw std::invalid_argument("a policy with " + std::to_string(input_dim) +
+                              " inputs fits no state layout for " + std::to_string(num_thrusters) +
+                              " thrusters: expected " + expected);
+}
+
 }  // namespace auvrl::task

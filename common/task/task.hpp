@@ -37,6 +37,11 @@ enum class StateLayout {
 };
 
 StateLayout parse_layout(const std::string& name);  ///< "paper", "extended", "extended_thrust"
+
+/// The state layout a policy network was trained with, from its input size: 12 + n is the
+/// paper's layout (18 with six thrusters), 17 + n the extended one (23), 17 + 2n the extended
+/// one with the thrusters' realised thrust (29). Throws std::invalid_argument otherwise.
+StateLayout infer_layout(int input_dim, int num_thrusters);
 const char* to_string(StateLayout layout);
 
 /// Which reward function.
