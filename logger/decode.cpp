@@ -182,6 +182,11 @@ class BodyDecoder {
                                 " (it counts the NUL, so it is at least 1)");
         }
         if (!need(name, static_cast<std::size_t>(length))) return false;
+        // LCM strings are C strings: the generated code cannot carry a NUL before the end
+        // (it re-encodes up to the first one), so neither may the decoder.
+        if (std::memchr(data_ + pos_, 0, static_cast<std::size_t>(length) - 1) != nullptr) {
+          return fail(name, "a NUL byte inside the string (LCM strings end at their first NUL)");
+        }
         field.text.assign(reinterpret_cast<const char*>(data_ + pos_),
                           static_cast<std::size_t>(length) - 1);
         pos_ += static_cast<std::size_t>(length);

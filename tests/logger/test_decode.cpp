@@ -8,6 +8,7 @@
 #include <auvrl_lcm/vehicle_state_t.hpp>
 #include <auvrl_logger_test/all_primitives_t.hpp>
 #include <auvrl_logger_test/nested_arrays_t.hpp>
+#include <algorithm>
 #include <map>
 #include <random>
 
@@ -189,6 +190,27 @@ TEST(Decode, EveryTruncationIsAnErrorNamingTheField) {
               DecodeStatus::kMalformed);
     EXPECT_NE(error.find("1 bytes left over"), std::string::npos) << error;
   }
+}
+
+TEST(Decode, AStringWithANulBeforeItsEndIsMalformed) {
+  // The generated code re-encodes a string up to its first NUL: a NUL inside is not a string
+  // it could have sent (found by the random corruption below).
+  const Schema schema = test_types::all_types_schema();
+  auvrl_lcm::vehicle_state_t state{};
+  state.vehicle_name = "nessie7";
+  std::vector<std::uint8_t> bytes = encode(state);
+  const auto at = std::search(bytes.begin(), bytes.end(), state.vehicle_name.begin(),
+                              state.vehicle_name.end());
+  ASSERT_NE(at, bytes.end());
+  DecodedMessage message;
+  std::string error;
+  ASSERT_EQ(decode_message(schema, bytes.data(), bytes.size(), message, error), DecodeStatus::kOk)
+      << error;
+  *(at + 3) = 0;  // "nes\0ie7"
+  EXPECT_EQ(decode_message(schema, bytes.data(), bytes.size(), message, error),
+            DecodeStatus::kMalformed);
+  EXPECT_NE(error.find("vehicle_name"), std::string::npos) << error;
+  EXPECT_NE(error.find("a NUL byte inside the string"), std::string::npos) << error;
 }
 
 TEST(Decode, RandomCorruptionNeverCrashesAndAgreesWithTheGeneratedCode) {
