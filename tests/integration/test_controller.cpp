@@ -120,7 +120,7 @@ TEST(Controller, StoppedStatesZeroTheThrustWithinThreeStepsAndResume) {
   FakeVehicle vehicle;
   ChildProcess controller = start_controller(dir, {});
   vehicle.drive(1.5, 5.0);
-  ASSERT_EQ(vehicle.status.supervisor_state, Status::STATE_ACTIVE) << controller.log();
+  ASSERT_EQ(vehicle.status.supervisor_state, +Status::STATE_ACTIVE) << controller.log();
   EXPECT_GT(vehicle.max_abs_command(), 1.0) << "the PID should drive toward the way-point";
   EXPECT_EQ(vehicle.status.waypoint_count, 1);
   EXPECT_NEAR(vehicle.status.distance_m, 10.0, 1e-6);
@@ -139,12 +139,12 @@ TEST(Controller, StoppedStatesZeroTheThrustWithinThreeStepsAndResume) {
   std::printf("[ figures  ] zero thrust %.3f s after the last state\n", zero_after_s);
   ASSERT_TRUE(zero_seen) << controller.log();
   EXPECT_LT(zero_after_s, 0.45) << controller.log();
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_STALE) << controller.log();
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_STALE) << controller.log();
   EXPECT_EQ(vehicle.status.reason, "no state for 3 control steps");
   EXPECT_EQ(vehicle.status.stale_events, 1);
   // They return: the PID drives again.
   vehicle.drive(0.5, 5.0);
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_ACTIVE) << controller.log();
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_ACTIVE) << controller.log();
   EXPECT_GT(vehicle.max_abs_command(), 1.0);
   EXPECT_EQ(controller.terminate(), 0) << controller.log();
   EXPECT_NE(controller.log().find("STALE: no state for 3 control steps"), std::string::npos)
@@ -157,21 +157,21 @@ TEST(Controller, ANaNStateZeroesTheThrustAndALimitAbortsWithTheReason) {
   FakeVehicle vehicle;
   ChildProcess controller = start_controller(dir, {});
   vehicle.drive(1.0, 5.0);
-  ASSERT_EQ(vehicle.status.supervisor_state, Status::STATE_ACTIVE) << controller.log();
+  ASSERT_EQ(vehicle.status.supervisor_state, +Status::STATE_ACTIVE) << controller.log();
   vehicle.publish(5.0, std::numeric_limits<double>::quiet_NaN());
   vehicle.listen(0.05);
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_NON_FINITE) << controller.log();
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_NON_FINITE) << controller.log();
   EXPECT_EQ(vehicle.max_abs_command(), 0.0);
   EXPECT_EQ(vehicle.status.non_finite_states, 1);
   vehicle.drive(0.3, 5.0);
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_ACTIVE) << controller.log();
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_ACTIVE) << controller.log();
   // Deeper than the mission's 20 m: aborted for good, zero thrust.
   vehicle.drive(0.3, 20.5);
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_ABORTED) << controller.log();
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_ABORTED) << controller.log();
   EXPECT_NE(vehicle.status.reason.find("max_depth_m"), std::string::npos) << vehicle.status.reason;
   EXPECT_EQ(vehicle.max_abs_command(), 0.0);
   vehicle.drive(0.3, 5.0);
-  EXPECT_EQ(vehicle.status.supervisor_state, Status::STATE_ABORTED);
+  EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_ABORTED);
   EXPECT_EQ(vehicle.max_abs_command(), 0.0);
   controller.terminate();
   EXPECT_NE(controller.log().find("ABORTED: "), std::string::npos) << controller.log();
@@ -205,7 +205,9 @@ TEST(Controller, FilesThatDoNotFitAreRefusedAtStartNamingThem) {
   const std::string bad = dir + "/bad.yaml";
   std::ofstream(bad) << "name: bad\nstart: {position_ned_m: [0, 0, 5], euler_rpy_rad: [0, 0, 0]}\n"
                         "waypoints:\n  - {position_ned_m: [1, 0, 5], reach_radius_m: -1}\n"
-                        "time_limit_s: 10\n";
+                        "time_limit_s: 10\n"
+                        "limits: {min_depth_m: 1, max_depth_m: 20, max_distance_from_start_m: 30, "
+                        "max_roll_rad: 1, max_pitch_rad: 1}\n";
   refused({bin, "--mission", bad, "--controller", "pid"}, bad);
   refused({bin, "--mission", bad, "--controller", "pid"}, "reach_radius_m");
 }
