@@ -68,6 +68,7 @@ class FakeVehicle {
     s.num_thrusters = static_cast<std::int8_t>(facts_.num_thrusters());
     s.thrust_realised_n.assign(static_cast<std::size_t>(s.num_thrusters), 0.0);
     transport::publish(*transport_, channels::sim_state(0), s);
+    last_state_at = std::chrono::steady_clock::now();
   }
   /// Publishes states at 10 Hz for `seconds`, keeping the newest command and status.
   void drive(double seconds, double depth_m, double surge_mps = 0.0) {
@@ -97,6 +98,7 @@ class FakeVehicle {
 
   auvrl_lcm::thruster_cmd_t command{};
   std::chrono::steady_clock::time_point command_at;
+  std::chrono::steady_clock::time_point last_state_at;
   Status status{};
 
  private:
@@ -124,9 +126,9 @@ TEST(Controller, StoppedStatesZeroTheThrustWithinThreeStepsAndResume) {
   EXPECT_GT(vehicle.max_abs_command(), 1.0) << "the PID should drive toward the way-point";
   EXPECT_EQ(vehicle.status.waypoint_count, 1);
   EXPECT_NEAR(vehicle.status.distance_m, 10.0, 1e-6);
-  // The states stop: zero thrust and STALE by the third missed step (0.3 s; 0.45 s allowed
-  // for the controller's half-step grace).
-  const auto stopped = std::chrono::steady_clock::now();
+  // The states stop: zero thrust and STALE at the third missed step. A step counts as missed
+  // half a step after its state was due, so at 3.5 control steps (0.35 s) after the last state.
+  const auto stopped = vehicle.last_state_at;
   bool zero_seen = false;
   double zero_after_s = -1;
   while (std::chrono::steady_clock::now() - stopped < std::chrono::seconds(2)) {
@@ -138,6 +140,7 @@ TEST(Controller, StoppedStatesZeroTheThrustWithinThreeStepsAndResume) {
   }
   std::printf("[ figures  ] zero thrust %.3f s after the last state\n", zero_after_s);
   ASSERT_TRUE(zero_seen) << controller.log();
+  EXPECT_GT(zero_after_s, 0.25) << controller.log();  // two missed steps hold the command
   EXPECT_LT(zero_after_s, 0.45) << controller.log();
   EXPECT_EQ(vehicle.status.supervisor_state, +Status::STATE_STALE) << controller.log();
   EXPECT_EQ(vehicle.status.reason, "no state for 3 control steps");
