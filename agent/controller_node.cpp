@@ -52,7 +52,8 @@ ControllerNode::ControllerNode(const sim::VehicleModel& model, task::TaskConfig 
       transport_(transport),
       log_(log),
       supervisor_(options_.stale_steps, mission_.limits.surface_on_abort),
-      states_(transport, channels::sim_state(options_.vehicle_id), 8) {
+      states_(transport, channels::sim_state(options_.vehicle_id), 8),
+      missions_(transport, channels::mission(options_.vehicle_id), 4) {
   task::apply_vehicle(model_.facts(), task_);
   task_.validate();
   if (!(options_.speed > 0)) throw std::invalid_argument("--speed must be > 0");
@@ -76,6 +77,7 @@ bool ControllerNode::finished() const {
 void ControllerNode::set_mission(Mission mission) {
   mission_ = std::move(mission);
   tracker_ = std::make_unique<MissionTracker>(mission_.waypoints);
+  supervisor_.new_mission(mission_.limits.surface_on_abort);
   first_state_time_s_.reset();
   controller_->reset();
   log_ << fmt::format("auv_controller: new mission '{}' ({} way-points)\n", mission_.name,
@@ -93,6 +95,7 @@ void ControllerNode::poll(int wait_ms) {
                                     next_due_ - now)
                                     .count()));
   transport_.handle(std::min(wait_ms, until_due));
+  if (auto msg = missions_.take()) on_mission(*msg);
   if (auto msg = states_.take()) {
     on_state(*msg);
     next_due_ = Clock::now() + period_ + period_ / 2;  // a state is due one step after this
@@ -101,6 +104,19 @@ void ControllerNode::poll(int wait_ms) {
     next_due_ += period_;
   }
   log_new_events();
+}
+
+void ControllerNode::on_mission(const auvrl_lcm::mission_t& msg) {
+  const std::string origin = channels::mission(options_.vehicle_id) + " message";
+  try {
+    if (msg.vehicle_id != options_.vehicle_id) {
+      throw std::invalid_argument(fmt::format("it is for vehicle {}", msg.vehicle_id));
+    }
+    set_mission(read_mission_text(msg.yaml, origin));
+  } catch (const std::exception& e) {
+    log_ << "auv_controller: mission refused, keeping '" << mission_.name << "': " << e.what()
+         << "\n";
+  }
 }
 
 void ControllerNode::check_vehicle(const auvrl_lcm::vehicle_state_t& msg) const {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <auvrl_lcm/mission_status_t.hpp>
+#include <auvrl_lcm/mission_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
 #include <chrono>
 #include <memory>
@@ -40,8 +41,8 @@ class ControllerNode {
                  ControllerNodeOptions options, transport::Transport& transport,
                  std::ostream& log);
 
-  /// Handles messages for up to wait_ms; acts on the newest state, or decides a missed control
-  /// step when one is due. Throws UnrecoverableFault when the state names another vehicle.
+  /// Handles messages for up to wait_ms; takes a new mission sent over MISSION_<id>; acts on the
+  /// newest state, or decides a missed control step when one is due. Throws UnrecoverableFault when the state names another vehicle.
   void poll(int wait_ms);
   /// Replaces the mission (a new one sent to the running controller): the tracker starts over
   /// from its first way-point; an abort stays an abort.
@@ -57,6 +58,8 @@ class ControllerNode {
   using Clock = std::chrono::steady_clock;
 
   void on_state(const auvrl_lcm::vehicle_state_t& msg);
+  /// A mission sent over MISSION_<id>: started, or refused (logged) keeping the current one.
+  void on_mission(const auvrl_lcm::mission_t& msg);
   void on_missed_step();
   void check_vehicle(const auvrl_lcm::vehicle_state_t& msg) const;
   void command(ThrustSource source);
@@ -74,6 +77,7 @@ class ControllerNode {
   std::unique_ptr<MissionTracker> tracker_;
   SafetySupervisor supervisor_;
   transport::Latest<auvrl_lcm::vehicle_state_t> states_;
+  transport::Latest<auvrl_lcm::mission_t> missions_;
 
   Clock::duration period_;
   Clock::time_point next_due_;      ///< when a control step without a state is decided

@@ -145,17 +145,37 @@ const config::Table<Mission>& mission_table() {
   return table;
 }
 
-Mission read_mission_file(const std::string& path) {
-  config::Section root = config::load_file(path);
+namespace {
+
+/// Reads a mission from its root section (a file's or a message's), events sorted by time.
+Mission read_mission(config::Section& root) {
   Mission mission;
   mission_table().read_keys(root, mission);
   root.finish();
-  mission.source_file = path;
-  if (mission.name.empty()) mission.name = file_stem(path);
-  mission.vehicle_path = config::resolve_path(root, mission.vehicle_path);
   std::stable_sort(
       mission.events.begin(), mission.events.end(),
       [](const MissionEvent& a, const MissionEvent& b) { return a.time_s < b.time_s; });
+  return mission;
+}
+
+}  // namespace
+
+Mission read_mission_file(const std::string& path) {
+  config::Section root = config::load_file(path);
+  Mission mission = read_mission(root);
+  mission.source_file = path;
+  if (mission.name.empty()) mission.name = file_stem(path);
+  mission.vehicle_path = config::resolve_path(root, mission.vehicle_path);
+  return mission;
+}
+
+Mission read_mission_text(const std::string& yaml_text, const std::string& origin) {
+  config::Section root = config::load_text(yaml_text, origin);
+  Mission mission = read_mission(root);
+  if (!mission.vehicle_path.empty()) {
+    root.fail("vehicle", "a mission sent to a running controller cannot change its vehicle");
+  }
+  if (mission.name.empty()) mission.name = origin;
   return mission;
 }
 

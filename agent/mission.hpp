@@ -90,6 +90,10 @@ const config::Table<Mission>& mission_table();
 /// unknown key, a way-point without position, a negative radius, an inverted depth range, an
 /// event without its values, ...) or the file alone (missing, not YAML).
 Mission read_mission_file(const std::string& path);
+/// The same for a mission sent as YAML text (a MISSION_<id> message); `origin` names it in
+/// errors and is its name if it has none. It must not name a vehicle (the controller's is
+/// fixed).
+Mission read_mission_text(const std::string& yaml_text, const std::string& origin);
 
 /// Why an observation leaves the mission's limits, naming the limit and the value (e.g.
 /// "depth 20.31 m > max_depth_m 20 m"); nothing while it is inside them.

@@ -104,4 +104,9 @@ void SafetySupervisor::mission_done(double time_s) {
   }
 }
 
+void SafetySupervisor::new_mission(bool surface_on_abort) {
+  surface_on_abort_ = surface_on_abort;
+  done_ = false;
+}
+
 }  // namespace auvrl::agent

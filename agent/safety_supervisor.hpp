@@ -71,6 +71,8 @@ class SafetySupervisor {
   ThrustSource on_action(double time_s, const task::ActionVector& action);
   /// The mission is complete (kDone; the controller keeps holding its last way-point).
   void mission_done(double time_s);
+  /// A new mission: not done any more, with its own abort command (an abort stays an abort).
+  void new_mission(bool surface_on_abort);
 
   SupervisorState state() const { return state_; }
   /// Why the state is not kActive ("" while active).

@@ -30,6 +30,8 @@ inline const std::string kLearnerStats = "LEARNER_STATS";
 inline const std::string kEpisode = "EPISODE";
 /// auv_logger's heartbeat (logger_heartbeat_t).
 inline const std::string kLoggerHeartbeat = "LOGGER_HEARTBEAT";
+/// A new mission for vehicle id's running auv_controller (mission_t).
+inline std::string mission(int vehicle_id) { return "MISSION_" + std::to_string(vehicle_id); }
 /// auv_controller's mission progress and safety state (mission_status_t).
 inline const std::string kMissionStatus = "MISSION_STATUS";
 

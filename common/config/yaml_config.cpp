@@ -259,6 +259,16 @@ Section load_file(const std::string& path) {
   return Section(path, "", root);
 }
 
+Section load_text(const std::string& text, const std::string& origin) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  return Section(origin, "", root);
+}
+
 }  // namespace auvrl::config
 
 namespace auvrl::config {

@@ -94,6 +94,8 @@ class Section {
 /// Loads a YAML file whose top level is a map; throws ConfigError naming the file on a
 /// missing file or a syntax error.
 Section load_file(const std::string& path);
+/// The same for YAML text that arrived otherwise (a message); `origin` names it in errors.
+Section load_text(const std::string& text, const std::string& origin);
 
 }  // namespace auvrl::config
 

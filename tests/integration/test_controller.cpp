@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 
 #include <auvrl_lcm/mission_status_t.hpp>
+#include <auvrl_lcm/mission_t.hpp>
 #include <auvrl_lcm/thruster_cmd_t.hpp>
 #include <auvrl_lcm/vehicle_reset_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
@@ -89,6 +90,9 @@ class FakeVehicle {
       }
       if (auto s = status_.take()) status = *s;
     }
+  }
+  void send(const auvrl_lcm::mission_t& mission) {
+    transport::publish(*transport_, channels::mission(0), mission);
   }
   double max_abs_command() const {
     double m = 0;
@@ -178,6 +182,38 @@ TEST(Controller, ANaNStateZeroesTheThrustAndALimitAbortsWithTheReason) {
   EXPECT_EQ(vehicle.max_abs_command(), 0.0);
   controller.terminate();
   EXPECT_NE(controller.log().find("ABORTED: "), std::string::npos) << controller.log();
+}
+
+TEST(Controller, ANewMissionSentOverLcmReplacesTheRunningOne) {
+  const std::string dir = test_support::make_temp_dir("auvrl_controller_new_mission_");
+  write_mission(dir);
+  FakeVehicle vehicle;
+  ChildProcess controller = start_controller(dir, {});
+  vehicle.drive(1.0, 5.0);
+  ASSERT_EQ(vehicle.status.mission_name, "ahead") << controller.log();
+  auvrl_lcm::mission_t mission{};
+  mission.yaml =
+      "name: sideways\nstart: {position_ned_m: [0, 0, 5]}\n"
+      "waypoints:\n  - {position_ned_m: [0, 8, 6]}\n  - {position_ned_m: [0, 0, 5]}\n"
+      "time_limit_s: 60\nlimits: {min_depth_m: 1, max_depth_m: 20, "
+      "max_distance_from_start_m: 30, max_roll_rad: 1, max_pitch_rad: 1}\n";
+  vehicle.send(mission);
+  vehicle.drive(0.5, 5.0);
+  EXPECT_EQ(vehicle.status.mission_name, "sideways") << controller.log();
+  EXPECT_EQ(vehicle.status.waypoint_count, 2);
+  EXPECT_EQ(vehicle.status.goal_ned_m[1], 8.0);
+  // One that would change the vehicle is refused; the running mission stays.
+  mission.yaml = "vehicle: other.yaml\n" + mission.yaml;
+  vehicle.send(mission);
+  vehicle.drive(0.5, 5.0);
+  EXPECT_EQ(vehicle.status.mission_name, "sideways") << controller.log();
+  EXPECT_EQ(controller.terminate(), 0);
+  EXPECT_NE(controller.log().find("new mission 'sideways' (2 way-points)"), std::string::npos)
+      << controller.log();
+  EXPECT_NE(controller.log().find("mission refused, keeping 'sideways'"), std::string::npos)
+      << controller.log();
+  EXPECT_NE(controller.log().find("cannot change its vehicle"), std::string::npos)
+      << controller.log();
 }
 
 TEST(Controller, FilesThatDoNotFitAreRefusedAtStartNamingThem) {
