@@ -1,6 +1,7 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
 // library that does the work (eval/evaluation.hpp for eval, tools/arrival_search.hpp for fastest,
-// tuning/pid_tuning.hpp for tune-pid); adding one is adding a row to kSubcommands.
+// tuning/pid_tuning.hpp for tune-pid, launcher/mission_run.hpp for run); adding one is adding a
+// row to kSubcommands.
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -12,6 +13,7 @@
 #include "eval/evaluation.hpp"
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
+#include "launcher/mission_run.hpp"
 #include "tools/arrival_search.hpp"
 #include "tuning/pid_tuning.hpp"
 
@@ -167,6 +169,40 @@ int run_train(int argc, const char* const* argv) {
   return auvrl::launcher::start_training(options, network == "host", std::cout);
 }
 
+/// `auvrl run`: a mission flown by auv_controller on the real-time simulator.
+int run_mission_command(int argc, const char* const* argv) {
+  auvrl::launcher::MissionRunOptions options;
+  options.source_dir = AUVRL_SOURCE_DIR;
+  options.bin_dir = own_bin_dir();
+  std::string network = "private";
+  auvrl::cli::CommandLine cli(
+      "auvrl run",
+      "Flies a mission with auv_controller (a policy or the PID) on auv_sim --realtime, with\n"
+      "auv_logger, in a private network namespace: shows its progress, injects its timed\n"
+      "thruster faults live, stops when the controller exits, the time limit passes or on\n"
+      "Ctrl-C, then writes RUN/trajectory.csv, waypoints.csv, vehicle.csv, plots/ and report.md.\n"
+      "Exit: 0 complete, 1 error, 3 aborted by the supervisor, 4 time limit, 130 stopped.");
+  cli.option("mission", &options.mission_path, "mission file (config/missions/*.yaml)");
+  cli.require("mission");
+  cli.option("policy", &options.policy_path, "policy network file (the nn format)");
+  cli.option("controller", &options.controller, "policy (with --policy) or pid");
+  cli.choices("controller", {"policy", "pid"});
+  cli.option("vehicle", &options.vehicle_path,
+             "vehicle file (default: the mission's vehicle:, else config/vehicles/nessie7.yaml)");
+  cli.option("speed", &options.speed, "the vehicle runs this many times faster than real time");
+  cli.option("run-dir", &options.run_dir, "run directory (default runs/mission-<name>-<time>)");
+  cli.option("network", &network,
+             "private (default: own network namespace) or host (LCM on the host's network)");
+  cli.choices("network", {"private", "host"});
+  cli.option("bin-dir", &options.bin_dir,
+             "where auv_sim, auv_controller and auv_logger are (default: beside auvrl)");
+  // Set by auvrl run itself when it runs again inside the network namespace.
+  cli.flag("prepared", &options.prepared, "the run directory is prepared already (internal)");
+  cli.app().get_option("--prepared")->group("");
+  if (!cli.parse(argc, argv)) return 0;
+  return auvrl::launcher::start_mission_run(options, network == "host", std::cout);
+}
+
 /// `auvrl config-doc`: prints docs/configuration.md.
 int run_config_doc(int argc, const char* const* argv) {
   auvrl::cli::CommandLine cli("auvrl config-doc",
@@ -185,6 +221,8 @@ struct Subcommand {
 
 const Subcommand kSubcommands[] = {
     {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
+    {"run", "fly a mission with auv_controller on the real-time simulator (see --help)",
+     run_mission_command},
     {"eval", "evaluate a policy or the PID baseline on test1/test2/fault/current/suite", run_eval},
     {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
      run_fastest},

@@ -1,10 +1,6 @@
 #include "launcher/launcher.hpp"
 
-#include <unistd.h>
-
-#include <cstdlib>
-#include <stdexcept>
-
+#include "launcher/namespace_exec.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/training.hpp"
 
@@ -28,13 +24,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
 }
 
 std::vector<std::string> namespace_command(const TrainOptions& options) {
-  std::vector<std::string> args = {options.source_dir + "/scripts/netns.sh",
-                                   "--pidfile",
-                                   options.run_dir + "/netns.pid",
-                                   options.bin_dir + "/auvrl",
-                                   "train",
-                                   "--resume",
-                                   options.run_dir};
+  std::vector<std::string> args = netns_prefix(options.source_dir, options.run_dir);
+  args.insert(args.end(), {options.bin_dir + "/auvrl", "train", "--resume", options.run_dir});
   const auto pass = [&args](const char* flag, const std::string& value) {
     args.insert(args.end(), {flag, value});
   };
@@ -51,17 +42,10 @@ std::vector<std::string> namespace_command(const TrainOptions& options) {
 }
 
 int start_training(TrainOptions options, bool host_network, std::ostream& out) {
-  const char* inside = std::getenv("AUVRL_IN_NETNS");
-  const bool in_namespace = inside != nullptr && std::string(inside) == "1";
+  const bool in_namespace = in_private_namespace();
   if (!in_namespace) prepare_run_directory(options);
   if (host_network || in_namespace) return run_training(options, out);
-  std::vector<std::string> args = namespace_command(options);
-  setenv("AUVRL_IN_NETNS", "1", 1);
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  execv(args[0].c_str(), argv.data());
-  throw std::runtime_error("cannot run " + args[0]);
+  exec_in_namespace(namespace_command(options));
 }
 
 }  // namespace auvrl::launcher

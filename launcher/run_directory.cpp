@@ -15,14 +15,14 @@ namespace auvrl::launcher {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-std::string timestamp() {
+std::string run_timestamp() {
   const std::time_t now = std::time(nullptr);
   char text[32];
   std::strftime(text, sizeof text, "%Y%m%d-%H%M%S", std::localtime(&now));
   return text;
 }
+
+namespace {
 
 /// Copies the configuration into the run directory with its vehicle made absolute (the one
 /// given by --vehicle, else the file's own), so that every process reads the same vehicle
@@ -83,7 +83,7 @@ std::string prepare_run_directory(TrainOptions& o) {
   read_run_config(o.config_path);  // a broken configuration fails here, before anything starts
   if (o.run_dir.empty()) {
     o.run_dir = (fs::path(o.source_dir) / "runs" /
-                 (fs::path(o.config_path).stem().string() + "-" + timestamp()))
+                 (fs::path(o.config_path).stem().string() + "-" + run_timestamp()))
                     .string();
   }
   if (fs::exists(fs::path(o.run_dir) / "config.yaml")) {

@@ -13,6 +13,9 @@ struct TrainOptions;
 /// what is wrong.
 std::string prepare_run_directory(TrainOptions& options);
 
+/// The local time as run directories name it: 20250131-142501.
+std::string run_timestamp();
+
 /// Whether dir holds a finished learner checkpoint (checkpoint-<updates>.ckpt). A learner
 /// killed while writing leaves only its temporary file, which --resume cannot use.
 bool has_checkpoint_file(const std::string& dir);

@@ -1,0 +1,170 @@
+#include "launcher/mission_record.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/csv.hpp"
+
+namespace auvrl::launcher {
+
+namespace {
+
+constexpr int kCsvDigits = 9;
+
+task::Observation observation_of(const auvrl_lcm::vehicle_state_t& msg) {
+  task::Observation o;
+  for (int i = 0; i < 3; ++i) {
+    o.position_ned_m[i] = msg.position_ned_m[i];
+    o.euler_rpy_rad[i] = msg.euler_rpy_rad[i];
+    o.velocity_body_mps[i] = msg.velocity_body_mps[i];
+    o.angular_rate_body_rad_s[i] = msg.angular_rate_body_rad_s[i];
+  }
+  return o;
+}
+
+}  // namespace
+
+MissionRecorder::MissionRecorder(int num_thrusters)
+    : num_thrusters_(num_thrusters), command_n_(static_cast<std::size_t>(num_thrusters), 0.0) {}
+
+void MissionRecorder::add_state(const auvrl_lcm::vehicle_state_t& state, double wall_s) {
+  if (state.num_thrusters != num_thrusters_) return;
+  if (!states_.empty() && state.sim_time_s < states_.back().sim_time_s && !start_estimate_s_) {
+    states_.clear();  // the vehicle was reset again before the mission started: a new clock
+  }
+  if (!states_.empty() && state.sim_time_s <= states_.back().sim_time_s) return;
+  agent::TrajectoryRow row;
+  row.time_s = state.sim_time_s;
+  row.observation = observation_of(state);
+  row.thrust_command_n = command_n_;
+  row.thrust_realised_n = state.thrust_realised_n;
+  states_.push_back({state.sim_time_s, wall_s, std::move(row)});
+}
+
+void MissionRecorder::add_command(const auvrl_lcm::thruster_cmd_t& command) {
+  if (command.num_thrusters != num_thrusters_) return;
+  command_n_ = command.thrust_n;
+}
+
+void MissionRecorder::add_status(const auvrl_lcm::mission_status_t& status) {
+  status_ = status;
+  using State = auvrl_lcm::mission_status_t;
+  if (states_.empty() || status.supervisor_state == State::STATE_WAITING) return;
+  const double estimate = states_.back().sim_time_s - status.elapsed_s;
+  if (!start_estimate_s_ || estimate < *start_estimate_s_) start_estimate_s_ = estimate;
+}
+
+std::size_t MissionRecorder::first_mission_sample() const {
+  if (!start_estimate_s_ || states_.empty()) return states_.size();
+  // The recorded state nearest the estimate (the times are increasing).
+  const auto after = std::lower_bound(states_.begin(), states_.end(), *start_estimate_s_,
+                                      [](const Sample& s, double t) { return s.sim_time_s < t; });
+  std::size_t i = static_cast<std::size_t>(after - states_.begin());
+  if (i == states_.size() || (i > 0 && *start_estimate_s_ - states_[i - 1].sim_time_s <
+                                           states_[i].sim_time_s - *start_estimate_s_)) {
+    --i;
+  }
+  return i;
+}
+
+std::optional<double> MissionRecorder::start_time_s() const {
+  const std::size_t first = first_mission_sample();
+  if (first >= states_.size()) return std::nullopt;
+  return states_[first].sim_time_s;
+}
+
+std::optional<double> MissionRecorder::mission_time_s() const {
+  const std::optional<double> start = start_time_s();
+  if (!start) return std::nullopt;
+  return states_.back().sim_time_s - *start;
+}
+
+double MissionRecorder::last_state_wall_s() const {
+  return states_.empty() ? -1.0 : states_.back().wall_s;
+}
+
+std::vector<agent::TrajectoryRow> MissionRecorder::trajectory() const {
+  std::vector<agent::TrajectoryRow> rows;
+  const std::size_t first = first_mission_sample();
+  if (first >= states_.size()) return rows;
+  const double start = states_[first].sim_time_s;
+  for (std::size_t i = first; i < states_.size(); ++i) {
+    rows.push_back(states_[i].row);
+    rows.back().time_s = states_[i].sim_time_s - start;
+  }
+  return rows;
+}
+
+double MissionRecorder::mission_wall_s() const {
+  const std::size_t first = first_mission_sample();
+  if (first >= states_.size()) return 0.0;
+  return states_.back().wall_s - states_[first].wall_s;
+}
+
+std::vector<WaypointRow> analyse_waypoints(const std::vector<agent::MissionWaypoint>& waypoints,
+                                           std::vector<agent::TrajectoryRow>& rows,
+                                           double max_thrust_n) {
+  agent::MissionTracker tracker(waypoints);
+  std::vector<WaypointRow> out(waypoints.size());
+  for (std::size_t i = 0; i < waypoints.size(); ++i) {
+    out[i].number = static_cast<int>(i) + 1;
+    out[i].waypoint = waypoints[i];
+  }
+  for (agent::TrajectoryRow& row : rows) {
+    // The way-point current at this row (the last one once the mission is done).
+    row.distance_m = (tracker.goal_ned_m() - row.observation.position_ned_m).norm();
+    const auto current = static_cast<std::size_t>(tracker.index());
+    if (current < out.size() && !row.thrust_command_n.empty()) {
+      double sum = 0.0;
+      for (double f : row.thrust_command_n) sum += (f / max_thrust_n) * (f / max_thrust_n);
+      out[current].energy += sum / static_cast<double>(row.thrust_command_n.size());
+      ++out[current].steps;
+    }
+    tracker.update(row.time_s, row.observation.position_ned_m);
+  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i].result = tracker.results()[i];
+  return out;
+}
+
+void write_waypoints_csv(const std::string& path, const std::vector<WaypointRow>& rows) {
+  csv::Writer out(path,
+                  {"index", "x", "y", "z", "reached", "time_to_reach_s", "hold_error_m", "energy",
+                   "time_from_previous_s", "completed_s"},
+                  csv::Mode::kTruncate, kCsvDigits);
+  const auto time_or_empty = [&out](double v) -> csv::Writer& {
+    return v < 0 ? out.empty() : out.cell(v);
+  };
+  for (const WaypointRow& r : rows) {
+    const Eigen::Vector3d& p = r.waypoint.position_ned_m;
+    out.cell(r.number).cell(p.x()).cell(p.y()).cell(p.z()).cell(r.result.reached);
+    time_or_empty(r.result.time_to_reach_s);
+    time_or_empty(r.result.hold_error_m);
+    out.cell(r.energy);
+    time_or_empty(r.result.time_from_previous_s);
+    time_or_empty(r.result.completed_time_s);
+    out.end_row();
+  }
+  out.flush();
+}
+
+std::string format_waypoint_table(const std::vector<WaypointRow>& rows) {
+  const auto value = [](double v, int decimals) {
+    return v < 0 ? std::string("-") : fmt::format("{:.{}f}", v, decimals);
+  };
+  std::string out =
+      "| way-point | x, y, z (m) | reached | time to reach (s) | from previous (s) | hold error "
+      "(m) | energy |\n"
+      "|---|---|---|---|---|---|---|\n";
+  for (const WaypointRow& r : rows) {
+    const Eigen::Vector3d& p = r.waypoint.position_ned_m;
+    out += fmt::format("| {} | {:g}, {:g}, {:g} | {} | {} | {} | {} | {:.1f} |\n", r.number, p.x(),
+                       p.y(), p.z(), r.result.reached ? "yes" : "no",
+                       value(r.result.time_to_reach_s, 1), value(r.result.time_from_previous_s, 1),
+                       value(r.result.hold_error_m, 3), r.energy);
+  }
+  return out;
+}
+
+}  // namespace auvrl::launcher

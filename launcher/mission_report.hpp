@@ -1,0 +1,68 @@
+// The end of `auvrl run`: the plots (scripts/plot_mission.py) and RUN/report.md, from what the
+// run recorded.
+#pragma once
+
+#include <auvrl_lcm/mission_status_t.hpp>
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "agent/mission.hpp"
+#include "launcher/mission_record.hpp"
+#include "launcher/mission_run.hpp"
+
+namespace auvrl::launcher {
+
+/// An event of the mission as the run applied it.
+struct MissionRunEvent {
+  double time_s = 0;  ///< mission time when it was applied, s
+  std::string text;   ///< what, with its time ("t=20.0 s (due at 20 s): thruster 0 (T1) at ...")
+};
+
+/// What a mission run did, for its report.
+struct MissionRunSummary {
+  int exit_code = 0;  ///< MissionRunExit
+  std::string ended;  ///< why it stopped ("mission complete", "time limit of 120 s passed", ...)
+  double wall_s = 0;  ///< the whole command, from the first process started to the last stopped
+  /// Wall-clock from the mission's first state (the controller's first) to its last, s.
+  double mission_wall_s = 0;
+  double vehicle_time_s = 0;  ///< the vehicle clock over the same states, s
+  std::optional<auvrl_lcm::mission_status_t> last_status;  ///< the last MISSION_STATUS
+  std::vector<MissionRunEvent> events;                     ///< the events applied, in order
+  std::vector<std::string> not_applied;  ///< events that could not be applied, and why
+  /// auv_sim's faults_total from its last heartbeat (live faults it applied); none if unheard.
+  std::optional<std::int64_t> sim_faults_total;
+  std::vector<WaypointRow> waypoints;
+  std::string plots_note;  ///< empty when the plots were drawn; otherwise why not
+};
+
+/// The real-time factor achieved: vehicle time / wall time (0 when no wall time passed).
+double achieved_realtime_factor(const MissionRunSummary& summary);
+
+/// Runs scripts/plot_mission.py on the run directory (RUN/plots/mission_3d.png and
+/// mission_thrusters.png); returns "" when it drew them, else a note saying why not (Python or
+/// matplotlib missing: the note says what to install; a failure: where its output is).
+std::string draw_mission_plots(const MissionRunOptions& options);
+
+/// The auv_controller lines of its log (processes/controller.log): its start, every event and
+/// way-point with its vehicle time, its end.
+std::vector<std::string> controller_event_lines(const std::string& log_path);
+
+/// Writes events.csv: time_s (mission time when applied), event (what). Throws
+/// std::runtime_error naming the path on failure.
+void write_events_csv(const std::string& path, const std::vector<MissionRunEvent>& events);
+
+/// Writes RUN/report.md: the mission and controller, how it ended, the per-way-point table,
+/// wall-clock, vehicle time and the real-time factor achieved, the supervisor's final state and
+/// counters, the events injected (and those that could not be), the controller's log lines, the
+/// plots. Throws std::runtime_error naming the path on failure.
+void write_mission_report(const MissionRunOptions& options, const agent::Mission& mission,
+                          const MissionRunSummary& summary);
+
+/// The lines printed at the end: the table, the times and where the files are.
+void print_mission_summary(const MissionRunOptions& options, const MissionRunSummary& summary,
+                           std::ostream& out);
+
+}  // namespace auvrl::launcher
