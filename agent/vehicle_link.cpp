@@ -5,6 +5,20 @@
 
 namespace auvrl::agent {
 
+VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& s) {
+  VehicleReport r;
+  for (int i = 0; i < 3; ++i) {
+    r.observation.position_ned_m[i] = s.position_ned_m[i];
+    r.observation.euler_rpy_rad[i] = s.euler_rpy_rad[i];
+    r.observation.velocity_body_mps[i] = s.velocity_body_mps[i];
+    r.observation.angular_rate_body_rad_s[i] = s.angular_rate_body_rad_s[i];
+  }
+  r.thrust_realised_n = s.thrust_realised_n;
+  r.time_s = s.sim_time_s;
+  r.blown_up = s.status != auvrl_lcm::vehicle_state_t::STATUS_OK;
+  return r;
+}
+
 namespace {
 
 class InProcessLink final : public VehicleLink {
@@ -90,17 +104,7 @@ class LockstepLink final : public VehicleLink {
  private:
   std::optional<VehicleReport> convert(const std::optional<auvrl_lcm::vehicle_state_t>& s) const {
     if (!s || s->num_thrusters != num_thrusters_) return std::nullopt;
-    VehicleReport r;
-    for (int i = 0; i < 3; ++i) {
-      r.observation.position_ned_m[i] = s->position_ned_m[i];
-      r.observation.euler_rpy_rad[i] = s->euler_rpy_rad[i];
-      r.observation.velocity_body_mps[i] = s->velocity_body_mps[i];
-      r.observation.angular_rate_body_rad_s[i] = s->angular_rate_body_rad_s[i];
-    }
-    r.thrust_realised_n = s->thrust_realised_n;
-    r.time_s = s->sim_time_s;
-    r.blown_up = s->status != auvrl_lcm::vehicle_state_t::STATUS_OK;
-    return r;
+    return vehicle_report(*s);
   }
 
   /// The reply must come from the vehicle this actor expects.

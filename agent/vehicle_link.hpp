@@ -3,6 +3,8 @@
 // above it is the same either way.
 #pragma once
 
+#include <auvrl_lcm/vehicle_state_t.hpp>
+
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
@@ -22,6 +24,9 @@ struct VehicleReport {
   double time_s = 0.0;                    ///< since the reset, s
   bool blown_up = false;                  ///< the simulator flagged a numerical blow-up
 };
+
+/// What a vehicle_state_t message reports (the simulator's, or a real vehicle's driver's).
+VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& msg);
 
 /// Initial conditions and faults of an episode.
 struct EpisodeStart {
