@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
@@ -152,7 +153,11 @@ Mission read_mission_file(const std::string& path) {
   root.finish();
   mission.source_file = path;
   if (mission.name.empty()) mission.name = file_stem(path);
-  mission.vehicle_path = config::resolve_path(root, mission.vehicle_path);
+  if (!mission.vehicle_path.empty()) {
+    mission.vehicle_path = std::filesystem::path(config::resolve_path(root, mission.vehicle_path))
+                               .lexically_normal()
+                               .string();
+  }
   std::stable_sort(
       mission.events.begin(), mission.events.end(),
       [](const MissionEvent& a, const MissionEvent& b) { return a.time_s < b.time_s; });

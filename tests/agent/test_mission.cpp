@@ -68,7 +68,7 @@ TEST(MissionFile, ReadsEveryKey) {
   const Mission m = read_mission_file(path);
   EXPECT_EQ(m.name, "tour");
   EXPECT_EQ(m.source_file, path);
-  EXPECT_EQ(m.vehicle_path, (dir.path / "../vehicles/nessie7.yaml").string());
+  EXPECT_EQ(m.vehicle_path, (dir.path.parent_path() / "vehicles/nessie7.yaml").string());
   EXPECT_EQ(m.start.position_ned_m, Eigen::Vector3d(0, 0, 5));
   EXPECT_EQ(m.start.euler_rpy_rad, Eigen::Vector3d(0, 0, 3.1));
   ASSERT_EQ(m.waypoints.size(), 2u);
