@@ -49,11 +49,14 @@ config::Table<MissionEvent> make_event_table() {
   t.choice("kind", &E::kind, parse_event_kind, to_string, "thruster_efficiency, current",
            "what happens")
       .required();
-  t.field("thruster", &E::thruster, "", "thruster_efficiency: which thruster, from 0").range(0);
-  t.field("efficiency", &E::efficiency, "", "thruster_efficiency: share of its thrust it gives")
+  t.field("thruster", &E::thruster, "",
+          "kind thruster_efficiency (required there): which thruster, from 0")
+      .range(0);
+  t.field("efficiency", &E::efficiency, "",
+          "kind thruster_efficiency (required there): share of its thrust it gives")
       .range(0.0, 1.0);
   t.field("current_ned_mps", &E::current_ned_mps, "m/s",
-          "current: the constant water velocity from then on, NED");
+          "kind current (required there): the constant water velocity from then on, NED");
   t.validate(check_event_keys);
   return t;
 }

@@ -285,9 +285,9 @@ MissionOutcome run_mission_request(const EvalRequest& request, std::ostream& out
   const sim::VehicleModel model = sim::load_vehicle_file(vehicle_path);
   EvaluationConfig config;
   std::unique_ptr<agent::Controller> controller = make_eval_controller(request, model, config);
-  out << fmt::format("mission {} ({}): {} way-points, {} events, time limit {} s\n", mission.name,
-                     mission.source_file, mission.waypoints.size(), mission.events.size(),
-                     mission.time_limit_s);
+  out << fmt::format("mission {} ({}): {} way-point(s), {} event(s), time limit {} s\n",
+                     mission.name, mission.source_file, mission.waypoints.size(),
+                     mission.events.size(), mission.time_limit_s);
   out << "vehicle " << describe(model.facts()) << ", from " << vehicle_source << "\n";
   if (request.controller == "pid") {
     const agent::VehiclePidGains gains = agent::pid_gains_for(model);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "agent/mission.hpp"
@@ -187,6 +188,16 @@ TEST(MissionFile, RefusesMalformedFilesNamingKeyAndLine) {
 
 TEST(MissionFile, MissingFileIsAnErrorNamingIt) {
   EXPECT_THROW(read_mission_file("/nonexistent/auvrl/mission.yaml"), config::ConfigError);
+}
+
+TEST(MissionFile, DocsMissionsHoldsTheKeysTableAsGenerated) {
+  std::ifstream in(std::string(AUVRL_DOCS_DIR) + "/missions.md");
+  ASSERT_TRUE(in.good());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string table = config::render_markdown({config::section_doc(mission_table())}, "");
+  EXPECT_NE(text.find(table), std::string::npos)
+      << "docs/missions.md: replace its `mission` table with `auvrl config-doc`'s:\n"
+      << table;
 }
 
 TEST(MissionFile, TableDocumentsEveryKeyWithItsUnit) {
