@@ -10,6 +10,7 @@
 #include "common/cli.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
+#include "eval/mission_run.hpp"
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
 #include "tools/arrival_search.hpp"
@@ -31,12 +32,23 @@ int run_eval(int argc, const char* const* argv) {
       "Runs a controller on the evaluation scenarios in process (no noise, the full 70 s each)\n"
       "and writes DIR/summary.csv and DIR/trajectories/<scenario>_<episode>.csv.\n"
       "Scenarios: test1, test2 (facing away), fault (T1 at 10 %), current (0.3 m/s across),\n"
-      "suite (random way-points of the training region), all.");
+      "suite (random way-points of the training region), all.\n"
+      "With --mission FILE it runs that mission (config/missions/*.yaml, docs/missions.md)\n"
+      "instead and writes DIR/mission.csv and DIR/trajectory.csv.");
   cli.option("policy", &request.policy_path, "policy network file (nn format)");
   cli.option("controller", &request.controller, "policy or pid");
   cli.option("scenario", &request.scenario, "test1|test2|fault|current|suite|all");
   cli.option("out", &request.out_dir, "output directory (created)");
-  cli.option("vehicle", &request.vehicle_path, "vehicle file");
+  cli.custom_option(
+      "vehicle",
+      [&request](const std::string& path) {
+        request.vehicle_path = path;
+        request.vehicle_given = true;
+      },
+      request.vehicle_path, "vehicle file (with --mission: in place of the mission's vehicle:)",
+      "FILE");
+  cli.option("mission", &request.mission_path,
+             "mission file: run it instead of the scenarios (docs/missions.md)");
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
@@ -47,7 +59,11 @@ int run_eval(int argc, const char* const* argv) {
              "trajectory files for the first N suite episodes (-1: all)");
   if (!cli.parse(argc, argv)) return 0;
   request.seed = static_cast<std::uint64_t>(seed);
-  auvrl::eval::run_eval_request(request, std::cout);
+  if (!request.mission_path.empty()) {
+    auvrl::eval::run_mission_request(request, std::cout);
+  } else {
+    auvrl::eval::run_eval_request(request, std::cout);
+  }
   return 0;
 }
 
@@ -185,7 +201,9 @@ struct Subcommand {
 
 const Subcommand kSubcommands[] = {
     {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
-    {"eval", "evaluate a policy or the PID baseline on test1/test2/fault/current/suite", run_eval},
+    {"eval",
+     "evaluate a policy or the PID baseline on test1/test2/fault/current/suite or a mission",
+     run_eval},
     {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
      run_fastest},
     {"tune-pid", "tune the PID baseline's gains for a vehicle (X.yaml -> X.pid.yaml)",
