@@ -344,7 +344,7 @@ std::string missing_onnx_tools(std::string& module_dir) {
   if (run({kPython, "-c", "import onnx"}, log, nullptr) != 0) {
     return "python3-onnx (apt-get install python3-onnx)";
   }
-  if (::access("/usr/bin/node", X_OK) != 0) return "/usr/bin/node (apt-get install nodejs)";
+  if (find_program("node").empty()) return "node on PATH (apt-get install nodejs)";
   if (!std::filesystem::exists(module_dir + "/onnxruntime-node/package.json")) {
     return "onnxruntime-node in " + module_dir + " (scripts/install-onnxruntime-node.sh)";
   }
@@ -376,7 +376,7 @@ TEST(PolicyExportOnnx, CheckedAndRunByOnnxruntimeNodeActsAsTheNetwork) {
   ASSERT_EQ(run({kPython, "-c", check, model}, dir.path("check.log"), &log), 0) << log;
   const std::vector<float> states = random_states(29, 1);
   write_raw(dir.path("states.f32"), states);
-  ASSERT_EQ(run({"/usr/bin/node", kOnnxRun, module_dir, model, dir.path("states.f32"), "29",
+  ASSERT_EQ(run({find_program("node"), kOnnxRun, module_dir, model, dir.path("states.f32"), "29",
                  dir.path("actions.f32")},
                 dir.path("node.log"), &log),
             0)
@@ -410,6 +410,25 @@ TEST(PolicyExportOnnx, SaysWhenPython3OnnxIsMissing) {
   EXPECT_THROW(run_export_request(request, said), std::runtime_error);
   EXPECT_FALSE(std::filesystem::exists(dir.path("p.onnx")));
   EXPECT_FALSE(std::filesystem::exists(dir.path("p.onnx.spec.json")));
+}
+
+TEST(PolicyExportOnnx, ScriptRefusesParametersThatDoNotMatchTheirChecksum) {
+  std::string module_dir;
+  const std::string missing = missing_onnx_tools(module_dir);
+  if (missing.rfind("python3-onnx", 0) == 0 || missing.rfind(kPython, 0) == 0) {
+    GTEST_SKIP() << "missing " << missing;
+  }
+  TempDir dir;
+  std::string spec = onnx_spec_json(load_exported_policy(kPolicy, vehicle_path(), ""));
+  const std::size_t weight = spec.find("\"weight\": [") + 11;
+  spec.replace(weight, spec.find(',', weight) - weight, "12.5");  // the first weight changes
+  std::ofstream(dir.path("spec.json")) << spec;
+  std::string log;
+  EXPECT_EQ(run({kPython, kOnnxScript, dir.path("spec.json"), dir.path("p.onnx")},
+                dir.path("script.log"), &log),
+            2);
+  EXPECT_NE(log.find("CRC-32"), std::string::npos) << log;
+  EXPECT_FALSE(std::filesystem::exists(dir.path("p.onnx")));
 }
 
 }  // namespace

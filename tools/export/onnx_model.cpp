@@ -92,7 +92,7 @@ std::string json_metadata(const ExportedPolicy& policy) {
       {"auvrl.scale_angular_rate_rad_s", fmt::format("{}", k.angular_rate_rad_s)},
       {"auvrl.scale_depth_m", fmt::format("{}", k.depth_m)},
       {"auvrl.control_step_s", fmt::format("{}", policy.vehicle.control_step_s)},
-      {"auvrl.policy_file", policy.policy_path},
+      {"auvrl.policy_file", std::filesystem::path(policy.policy_path).filename().string()},
       {"auvrl.policy_file_crc32", fmt::format("0x{:08x}", policy.policy_crc32)},
   };
   std::string out = "{";
