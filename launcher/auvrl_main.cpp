@@ -1,6 +1,7 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
 // library that does the work (eval/evaluation.hpp for eval, tools/arrival_search.hpp for fastest,
-// tuning/pid_tuning.hpp for tune-pid); adding one is adding a row to kSubcommands.
+// tuning/pid_tuning.hpp for tune-pid, tools/export/policy_export.hpp for export); adding one is
+// adding a row to kSubcommands.
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
 #include "tools/arrival_search.hpp"
+#include "tools/export/policy_export.hpp"
 #include "tuning/pid_tuning.hpp"
 
 namespace {
@@ -95,6 +97,32 @@ int run_fastest(int argc, const char* const* argv) {
   if (!cli.parse(argc, argv)) return 0;
   request.search.seed = static_cast<std::uint64_t>(seed);
   auvrl::tools::run_arrival_search_request(request, std::cout);
+  return 0;
+}
+
+/// `auvrl export`: a policy as a C99 header or an ONNX model.
+int run_export(int argc, const char* const* argv) {
+  auvrl::tools::ExportRequest request;
+  request.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+  request.onnx.script = std::string(AUVRL_SOURCE_DIR) + "/scripts/export_onnx.py";
+  auvrl::cli::CommandLine cli(
+      "auvrl export",
+      "Writes a trained policy for use outside auvrl (docs/export.md): --format c, one\n"
+      "self-contained C99 header (weights, auvrl_policy_act, auvrl_policy_build_state; needs\n"
+      "only <math.h>); --format onnx, an ONNX model (input \"state\", output \"action\"),\n"
+      "written by scripts/export_onnx.py with python3-onnx. Both document the state layout,\n"
+      "every input's scale and every action's thruster.");
+  cli.option("policy", &request.policy_path, "policy network file (nn format)");
+  cli.option("format", &request.format, "c or onnx");
+  cli.choices("format", {"c", "onnx"});
+  cli.option("out", &request.out_path, "the header or model to write");
+  cli.option("vehicle", &request.vehicle_path,
+             "vehicle file: thruster names and count, maximum thrust");
+  cli.option("layout", &request.layout,
+             "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
+             "/ 17+2n)");
+  if (!cli.parse(argc, argv)) return 0;
+  auvrl::tools::run_export_request(request, std::cout);
   return 0;
 }
 
@@ -206,6 +234,7 @@ const Subcommand kSubcommands[] = {
      run_eval},
     {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
      run_fastest},
+    {"export", "write a policy as a C99 header or an ONNX model (docs/export.md)", run_export},
     {"tune-pid", "tune the PID baseline's gains for a vehicle (X.yaml -> X.pid.yaml)",
      run_tune_pid},
     {"config-doc", "print the configuration reference (docs/configuration.md)", run_config_doc},
