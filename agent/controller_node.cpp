@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "agent/pid_controller.hpp"
+#include "agent/vehicle_link.hpp"
 #include "common/channels.hpp"
 #include "common/unrecoverable.hpp"
 
@@ -25,17 +26,6 @@ Eigen::VectorXd surfacing_thrust_n(const sim::VehicleModel& model) {
   Eigen::Matrix<double, 6, 1> tau = Eigen::Matrix<double, 6, 1>::Zero();
   tau[sim::kHeave] = -0.5 * heave_capacity_n;  // body z points down
   return PidController(model).allocate(tau);
-}
-
-task::Observation observation_of(const auvrl_lcm::vehicle_state_t& msg) {
-  task::Observation o;
-  for (int i = 0; i < 3; ++i) {
-    o.position_ned_m[i] = msg.position_ned_m[i];
-    o.euler_rpy_rad[i] = msg.euler_rpy_rad[i];
-    o.velocity_body_mps[i] = msg.velocity_body_mps[i];
-    o.angular_rate_body_rad_s[i] = msg.angular_rate_body_rad_s[i];
-  }
-  return o;
 }
 
 }  // namespace
@@ -131,14 +121,18 @@ void ControllerNode::check_vehicle(const auvrl_lcm::vehicle_state_t& msg) const 
 
 void ControllerNode::on_state(const auvrl_lcm::vehicle_state_t& msg) {
   check_vehicle(msg);
-  observation_ = observation_of(msg);
-  thrust_realised_n_ = msg.thrust_realised_n;
-  last_state_time_s_ = msg.sim_time_s;
+  const VehicleReport report = vehicle_report(msg);
+  observation_ = report.observation;
+  thrust_realised_n_ = report.thrust_realised_n;
+  last_state_time_s_ = report.time_s;
   if (!first_state_time_s_) first_state_time_s_ = last_state_time_s_;
   const double t = mission_time_s();
   const std::optional<std::string> violation =
       is_finite(observation_) ? check_limits(mission_, observation_) : std::nullopt;
-  ThrustSource source = supervisor_.on_state(t, observation_, violation);
+  ThrustSource source =
+      report.blown_up
+          ? supervisor_.on_unusable_state(t, fmt::format("the vehicle reports status {}", msg.status))
+          : supervisor_.on_state(t, observation_, violation);
   if (source == ThrustSource::kController) {
     const int before = tracker_->index();
     tracker_->update(t, observation_.position_ned_m);

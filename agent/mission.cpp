@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <stdexcept>
 
@@ -48,11 +49,14 @@ config::Table<MissionEvent> make_event_table() {
   t.choice("kind", &E::kind, parse_event_kind, to_string, "thruster_efficiency, current",
            "what happens")
       .required();
-  t.field("thruster", &E::thruster, "", "thruster_efficiency: which thruster, from 0").range(0);
-  t.field("efficiency", &E::efficiency, "", "thruster_efficiency: share of its thrust it gives")
+  t.field("thruster", &E::thruster, "",
+          "kind thruster_efficiency (required there): which thruster, from 0")
+      .range(0);
+  t.field("efficiency", &E::efficiency, "",
+          "kind thruster_efficiency (required there): share of its thrust it gives")
       .range(0.0, 1.0);
   t.field("current_ned_mps", &E::current_ned_mps, "m/s",
-          "current: the constant water velocity from then on, NED");
+          "kind current (required there): the constant water velocity from then on, NED");
   t.validate(check_event_keys);
   return t;
 }
@@ -165,7 +169,11 @@ Mission read_mission_file(const std::string& path) {
   Mission mission = read_mission(root);
   mission.source_file = path;
   if (mission.name.empty()) mission.name = file_stem(path);
-  mission.vehicle_path = config::resolve_path(root, mission.vehicle_path);
+  if (!mission.vehicle_path.empty()) {
+    mission.vehicle_path = std::filesystem::path(config::resolve_path(root, mission.vehicle_path))
+                               .lexically_normal()
+                               .string();
+  }
   return mission;
 }
 

@@ -85,6 +85,15 @@ ThrustSource SafetySupervisor::on_state(double time_s, const task::Observation& 
   return ThrustSource::kController;
 }
 
+ThrustSource SafetySupervisor::on_unusable_state(double time_s, const std::string& why) {
+  ++counters_.steps;
+  missed_in_row_ = 0;
+  if (state_ == SupervisorState::kAborted) return abort_source();
+  ++counters_.non_finite_states;
+  enter(SupervisorState::kNonFinite, time_s, why);
+  return ThrustSource::kZero;
+}
+
 ThrustSource SafetySupervisor::on_action(double time_s, const task::ActionVector& action) {
   if (!action.allFinite()) {
     ++counters_.non_finite_actions;

@@ -66,6 +66,9 @@ class SafetySupervisor {
   /// and pass its output to on_action(); anything else is what the thrusters get.
   ThrustSource on_state(double time_s, const task::Observation& observation,
                         const std::optional<std::string>& limit_violation);
+  /// A state its sender marks as not to be trusted (vehicle_state_t.status != 0): zero thrust
+  /// and kNonFinite with `why`, counted with the non-finite states.
+  ThrustSource on_unusable_state(double time_s, const std::string& why);
   /// The controller's output for the state on_state() accepted: kController if finite, else
   /// kZero (counted).
   ThrustSource on_action(double time_s, const task::ActionVector& action);

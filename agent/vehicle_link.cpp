@@ -5,6 +5,20 @@
 
 namespace auvrl::agent {
 
+VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& s) {
+  VehicleReport r;
+  for (int i = 0; i < 3; ++i) {
+    r.observation.position_ned_m[i] = s.position_ned_m[i];
+    r.observation.euler_rpy_rad[i] = s.euler_rpy_rad[i];
+    r.observation.velocity_body_mps[i] = s.velocity_body_mps[i];
+    r.observation.angular_rate_body_rad_s[i] = s.angular_rate_body_rad_s[i];
+  }
+  r.thrust_realised_n = s.thrust_realised_n;
+  r.time_s = s.sim_time_s;
+  r.blown_up = s.status != auvrl_lcm::vehicle_state_t::STATUS_OK;
+  return r;
+}
+
 namespace {
 
 class InProcessLink final : public VehicleLink {
@@ -23,6 +37,7 @@ class InProcessLink final : public VehicleLink {
                   start.thruster_efficiency.data(),
                   static_cast<Eigen::Index>(start.thruster_efficiency.size())));
     settings.current.constant_velocity_ned_mps = start.current_ned_mps;
+    settings.sensor_noise = start.sensor_noise;
     settings.seed = start.seed;
     state_ = sim::make_state(model_, settings);
     return report();
@@ -34,6 +49,21 @@ class InProcessLink final : public VehicleLink {
                                                  static_cast<Eigen::Index>(thrust_n.size()));
     sim::step(model_, *state_, command_);
     return report();
+  }
+
+  bool set_thruster_efficiency(const std::vector<double>& efficiency) override {
+    if (!state_) return false;
+    sim::set_thruster_efficiency(
+        model_, *state_,
+        Eigen::Map<const Eigen::VectorXd>(efficiency.data(),
+                                          static_cast<Eigen::Index>(efficiency.size())));
+    return true;
+  }
+
+  bool set_current(const Eigen::Vector3d& current_ned_mps) override {
+    if (!state_) return false;
+    sim::set_constant_current(*state_, current_ned_mps);
+    return true;
   }
 
  private:
@@ -77,6 +107,10 @@ class LockstepLink final : public VehicleLink {
     }
     msg.num_thrusters = static_cast<std::int8_t>(start.thruster_efficiency.size());
     msg.thruster_efficiency = start.thruster_efficiency;
+    msg.noise_position_m = start.sensor_noise.position_sigma_m;
+    msg.noise_attitude_rad = start.sensor_noise.attitude_sigma_rad;
+    msg.noise_velocity_mps = start.sensor_noise.linear_velocity_sigma_mps;
+    msg.noise_angular_rate_rad_s = start.sensor_noise.angular_velocity_sigma_rad_s;
     msg.seed = static_cast<std::int64_t>(start.seed);
     const std::optional<auvrl_lcm::vehicle_state_t> reply = client_.reset(msg);
     if (reply) check_vehicle(*reply);
@@ -90,17 +124,7 @@ class LockstepLink final : public VehicleLink {
  private:
   std::optional<VehicleReport> convert(const std::optional<auvrl_lcm::vehicle_state_t>& s) const {
     if (!s || s->num_thrusters != num_thrusters_) return std::nullopt;
-    VehicleReport r;
-    for (int i = 0; i < 3; ++i) {
-      r.observation.position_ned_m[i] = s->position_ned_m[i];
-      r.observation.euler_rpy_rad[i] = s->euler_rpy_rad[i];
-      r.observation.velocity_body_mps[i] = s->velocity_body_mps[i];
-      r.observation.angular_rate_body_rad_s[i] = s->angular_rate_body_rad_s[i];
-    }
-    r.thrust_realised_n = s->thrust_realised_n;
-    r.time_s = s->sim_time_s;
-    r.blown_up = s->status != auvrl_lcm::vehicle_state_t::STATUS_OK;
-    return r;
+    return vehicle_report(*s);
   }
 
   /// The reply must come from the vehicle this actor expects.

@@ -3,6 +3,8 @@
 // above it is the same either way.
 #pragma once
 
+#include <auvrl_lcm/vehicle_state_t.hpp>
+
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
@@ -23,6 +25,9 @@ struct VehicleReport {
   bool blown_up = false;                  ///< the simulator flagged a numerical blow-up
 };
 
+/// What a vehicle_state_t message reports (the simulator's, or a real vehicle's driver's).
+VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& msg);
+
 /// Initial conditions and faults of an episode.
 struct EpisodeStart {
   Eigen::Vector3d position_ned_m{0.0, 0.0, 5.0};
@@ -31,6 +36,7 @@ struct EpisodeStart {
   Eigen::Vector3d angular_rate_body_rad_s = Eigen::Vector3d::Zero();
   std::vector<double> thruster_efficiency;  ///< empty: all healthy
   Eigen::Vector3d current_ned_mps = Eigen::Vector3d::Zero();
+  sim::SensorNoise sensor_noise;  ///< on what the vehicle reports; all zero: exact
   std::uint64_t seed = 1;
 };
 
@@ -41,6 +47,13 @@ class VehicleLink {
   virtual int num_thrusters() const = 0;
   virtual std::optional<VehicleReport> reset(const EpisodeStart& start) = 0;
   virtual std::optional<VehicleReport> step(const std::vector<double>& thrust_n) = 0;
+  /// Changes the thruster efficiencies (one per thruster, each in [0, 1]) of the vehicle now
+  /// running, from the next step on (a mission's timed fault). Returns false where the link
+  /// cannot (the lockstep link); throws std::invalid_argument on unusable values.
+  virtual bool set_thruster_efficiency(const std::vector<double>& /*efficiency*/) { return false; }
+  /// Changes the constant water current (NED, m/s) from the next step on; false where the link
+  /// cannot (the lockstep link).
+  virtual bool set_current(const Eigen::Vector3d& /*current_ned_mps*/) { return false; }
 };
 
 /// The dynamics library in this process (deterministic, no transport).

@@ -313,9 +313,19 @@ std::string trajectory_csv_header(int num_thrusters) {
 }
 
 void write_trajectory_csv(const std::string& path, const std::vector<agent::TrajectoryRow>& rows,
-                          int num_thrusters) {
-  csv::Writer out(path, trajectory_columns(num_thrusters), csv::Mode::kTruncate, kCsvDigits);
+                          int num_thrusters, const std::vector<int>* waypoint_index) {
+  std::vector<std::string> columns = trajectory_columns(num_thrusters);
+  if (waypoint_index) {
+    if (waypoint_index->size() != rows.size()) {
+      throw std::invalid_argument(path + ": " + std::to_string(waypoint_index->size()) +
+                                  " way-point indices for " + std::to_string(rows.size()) +
+                                  " trajectory rows");
+    }
+    columns.push_back("waypoint");
+  }
+  csv::Writer out(path, columns, csv::Mode::kTruncate, kCsvDigits);
   const auto n = static_cast<std::size_t>(num_thrusters);
+  std::size_t row_index = 0;
   for (const agent::TrajectoryRow& r : rows) {
     if (r.thrust_command_n.size() != n || r.thrust_realised_n.size() != n) {
       throw std::invalid_argument(path + ": a trajectory row does not have " +
@@ -330,6 +340,8 @@ void write_trajectory_csv(const std::string& path, const std::vector<agent::Traj
     for (double f : r.thrust_command_n) out.cell(tidy(f));
     for (double f : r.thrust_realised_n) out.cell(tidy(f));
     out.cell(r.distance_m);
+    if (waypoint_index) out.cell((*waypoint_index)[row_index]);
+    ++row_index;
     out.end_row();
   }
   out.flush();

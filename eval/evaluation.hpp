@@ -145,9 +145,11 @@ std::string summary_csv_header();
 void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& rows);
 /// Header line of a trajectory file for n thrusters (no newline).
 std::string trajectory_csv_header(int num_thrusters);
-/// Writes a trajectory file; throws std::runtime_error naming the path on failure.
+/// Writes a trajectory file; throws std::runtime_error naming the path on failure. With
+/// waypoint_index (one per row: the mission's way-point the vehicle was driving to, from 0) a
+/// last column `waypoint` holds it.
 void write_trajectory_csv(const std::string& path, const std::vector<agent::TrajectoryRow>& rows,
-                          int num_thrusters);
+                          int num_thrusters, const std::vector<int>* waypoint_index = nullptr);
 
 /// One screen of text: per scenario, episodes, reached count, mean time to reach and mean
 /// hold error over the reached episodes, mean final error and mean thrust energy.
@@ -162,8 +164,13 @@ struct EvalRequest {
   std::string controller = "policy";  ///< or "pid"; "policy" needs policy_path
   std::string scenario = "all";
   std::string out_dir;       ///< required
-  std::string vehicle_path;  ///< vehicle file
-  std::string layout;        ///< "paper", "extended", "extended_thrust" or empty: from the policy
+  std::string vehicle_path;  ///< vehicle file (the default unless vehicle_given)
+  /// --vehicle was given: with a mission it overrides the mission's vehicle:.
+  bool vehicle_given = false;
+  /// A mission file (config/missions/*.yaml): run it (eval/mission_run.hpp) instead of the
+  /// scenarios.
+  std::string mission_path;
+  std::string layout;  ///< "paper", "extended", "extended_thrust" or empty: from the policy
   std::uint64_t seed = 1;
   int suite_episodes = 100;
   int suite_trajectories = 10;

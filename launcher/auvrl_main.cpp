@@ -1,7 +1,7 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
 // library that does the work (eval/evaluation.hpp for eval, tools/arrival_search.hpp for fastest,
-// tuning/pid_tuning.hpp for tune-pid, launcher/mission_run.hpp for run); adding one is adding a
-// row to kSubcommands.
+// tuning/pid_tuning.hpp for tune-pid, tools/export/policy_export.hpp for export,
+// launcher/mission_run.hpp for run); adding one is adding a row to kSubcommands.
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -11,10 +11,12 @@
 #include "common/cli.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
+#include "eval/mission_run.hpp"
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/mission_run.hpp"
 #include "tools/arrival_search.hpp"
+#include "tools/export/policy_export.hpp"
 #include "tuning/pid_tuning.hpp"
 
 namespace {
@@ -33,12 +35,23 @@ int run_eval(int argc, const char* const* argv) {
       "Runs a controller on the evaluation scenarios in process (no noise, the full 70 s each)\n"
       "and writes DIR/summary.csv and DIR/trajectories/<scenario>_<episode>.csv.\n"
       "Scenarios: test1, test2 (facing away), fault (T1 at 10 %), current (0.3 m/s across),\n"
-      "suite (random way-points of the training region), all.");
+      "suite (random way-points of the training region), all.\n"
+      "With --mission FILE it runs that mission (config/missions/*.yaml, docs/missions.md)\n"
+      "instead and writes DIR/mission.csv and DIR/trajectory.csv.");
   cli.option("policy", &request.policy_path, "policy network file (nn format)");
   cli.option("controller", &request.controller, "policy or pid");
   cli.option("scenario", &request.scenario, "test1|test2|fault|current|suite|all");
   cli.option("out", &request.out_dir, "output directory (created)");
-  cli.option("vehicle", &request.vehicle_path, "vehicle file");
+  cli.custom_option(
+      "vehicle",
+      [&request](const std::string& path) {
+        request.vehicle_path = path;
+        request.vehicle_given = true;
+      },
+      request.vehicle_path, "vehicle file (with --mission: in place of the mission's vehicle:)",
+      "FILE");
+  cli.option("mission", &request.mission_path,
+             "mission file: run it instead of the scenarios (docs/missions.md)");
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
@@ -49,7 +62,11 @@ int run_eval(int argc, const char* const* argv) {
              "trajectory files for the first N suite episodes (-1: all)");
   if (!cli.parse(argc, argv)) return 0;
   request.seed = static_cast<std::uint64_t>(seed);
-  auvrl::eval::run_eval_request(request, std::cout);
+  if (!request.mission_path.empty()) {
+    auvrl::eval::run_mission_request(request, std::cout);
+  } else {
+    auvrl::eval::run_eval_request(request, std::cout);
+  }
   return 0;
 }
 
@@ -81,6 +98,32 @@ int run_fastest(int argc, const char* const* argv) {
   if (!cli.parse(argc, argv)) return 0;
   request.search.seed = static_cast<std::uint64_t>(seed);
   auvrl::tools::run_arrival_search_request(request, std::cout);
+  return 0;
+}
+
+/// `auvrl export`: a policy as a C99 header or an ONNX model.
+int run_export(int argc, const char* const* argv) {
+  auvrl::tools::ExportRequest request;
+  request.vehicle_path = std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml";
+  request.onnx.script = std::string(AUVRL_SOURCE_DIR) + "/scripts/export_onnx.py";
+  auvrl::cli::CommandLine cli(
+      "auvrl export",
+      "Writes a trained policy for use outside auvrl (docs/export.md): --format c, one\n"
+      "self-contained C99 header (weights, auvrl_policy_act, auvrl_policy_build_state; needs\n"
+      "only <math.h>); --format onnx, an ONNX model (input \"state\", output \"action\"),\n"
+      "written by scripts/export_onnx.py with python3-onnx. Both document the state layout,\n"
+      "every input's scale and every action's thruster.");
+  cli.option("policy", &request.policy_path, "policy network file (nn format)");
+  cli.option("format", &request.format, "c or onnx");
+  cli.choices("format", {"c", "onnx"});
+  cli.option("out", &request.out_path, "the header or model to write");
+  cli.option("vehicle", &request.vehicle_path,
+             "vehicle file: thruster names and count, maximum thrust");
+  cli.option("layout", &request.layout,
+             "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
+             "/ 17+2n)");
+  if (!cli.parse(argc, argv)) return 0;
+  auvrl::tools::run_export_request(request, std::cout);
   return 0;
 }
 
@@ -223,9 +266,12 @@ const Subcommand kSubcommands[] = {
     {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
     {"run", "fly a mission with auv_controller on the real-time simulator (see --help)",
      run_mission_command},
-    {"eval", "evaluate a policy or the PID baseline on test1/test2/fault/current/suite", run_eval},
+    {"eval",
+     "evaluate a policy or the PID baseline on test1/test2/fault/current/suite or a mission",
+     run_eval},
     {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
      run_fastest},
+    {"export", "write a policy as a C99 header or an ONNX model (docs/export.md)", run_export},
     {"tune-pid", "tune the PID baseline's gains for a vehicle (X.yaml -> X.pid.yaml)",
      run_tune_pid},
     {"config-doc", "print the configuration reference (docs/configuration.md)", run_config_doc},

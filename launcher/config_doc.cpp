@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "agent/actor_node.hpp"
+#include "agent/mission.hpp"
 #include "agent/pid_gains.hpp"
 #include "common/config/table.hpp"
 #include "common/task/goal_schedule.hpp"
@@ -24,8 +25,9 @@ constexpr const char* kPreamble =
     "(config/presets/*.yaml); unknown keys are errors. The keys of `learner:` are also\n"
     "auv_learner's flags, those of `task:` and `actor:` auv_actor's (`replay_capacity` is\n"
     "`--replay-capacity`, `scales.depth_m` is `--scales-depth-m`; a bool `key` has `--key`\n"
-    "and `--no-key`). The last two sections are a vehicle file (config/vehicles/X.yaml) and\n"
-    "its PID gains file (config/vehicles/X.pid.yaml, written by `auvrl tune-pid`).\n";
+    "and `--no-key`). Then come a vehicle file (config/vehicles/X.yaml), its PID gains file\n"
+    "(config/vehicles/X.pid.yaml, written by `auvrl tune-pid`) and a mission file\n"
+    "(config/missions/X.yaml, docs/missions.md).\n";
 
 }  // namespace
 
@@ -39,7 +41,8 @@ std::string configuration_reference() {
       config::section_doc(finetune_table()),
       config::section_doc(transport::transport_table()),
       sim::vehicle_file_doc(),
-      config::section_doc(agent::pid_gains_table())};
+      config::section_doc(agent::pid_gains_table()),
+      config::section_doc(agent::mission_table())};
   return config::render_markdown(sections, kPreamble);
 }
 

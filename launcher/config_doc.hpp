@@ -7,7 +7,7 @@
 namespace auvrl::launcher {
 
 /// docs/configuration.md as `auvrl config-doc` prints it: the run file's sections, then the
-/// vehicle file's blocks.
+/// vehicle file's blocks, the PID gains file and the mission file.
 std::string configuration_reference();
 
 }  // namespace auvrl::launcher

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Installs every Debian package auvrl needs, if missing. Idempotent; silent when all is there.
+# Installs every Debian package auvrl needs, if missing, then onnxruntime-node (the ONNX
+# runtime of the export tests, from the npm registry, into third_party/node: git-ignored).
+# Idempotent; silent when all is there.
 set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
 
 packages=(
   # build
@@ -17,6 +20,9 @@ packages=(
   util-linux iproute2 nftables procps iptables libnetfilter-queue-dev
   # plots
   python3 python3-matplotlib python3-numpy
+  # auvrl export --format onnx (scripts/export_onnx.py); node for the export tests' ONNX
+  # runtime (scripts/install-onnxruntime-node.sh; npm below)
+  python3-onnx nodejs
 )
 
 missing=()
@@ -24,7 +30,15 @@ for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
   [ "$status" = "install ok installed" ] || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+# npm: Debian's package, unless the installed nodejs brings its own (NodeSource's does).
+command -v npm >/dev/null || missing+=(npm)
+# The npm registry may be out of reach where apt's mirror is not: the ONNX export test then
+# shows as skipped, and nothing else needs the module.
+ort_node() {
+  "$here/install-onnxruntime-node.sh" ||
+    echo "install-deps: onnxruntime-node not installed: the ONNX export test will be skipped" >&2
+}
+if [ ${#missing[@]} -eq 0 ]; then ort_node; exit 0; fi
 
 sudo=()
 if [ "$(id -u)" -ne 0 ]; then
@@ -35,3 +49,4 @@ echo "install-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -qq
 "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+ort_node

@@ -509,6 +509,15 @@ void set_thruster_efficiency(const VehicleModel& model, VehicleState& state,
   state.thruster_efficiency = checked_efficiency(model, efficiency, "thruster_efficiency");
 }
 
+void set_constant_current(VehicleState& state, const Vector3& current_ned_mps) {
+  if (!current_ned_mps.allFinite()) {
+    invalid("current.constant_velocity_ned_mps", "expected finite numbers");
+  }
+  // The water velocity is the constant part plus the varying one (current_from_speed).
+  state.current_velocity_ned_mps += current_ned_mps - state.current.constant_velocity_ned_mps;
+  state.current.constant_velocity_ned_mps = current_ned_mps;
+}
+
 void step(const VehicleModel& model, VehicleState& state, const ThrusterVector& thrust_command_n) {
   step_impl(model, state, thrust_command_n, /*ideal=*/false);
 }

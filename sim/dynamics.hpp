@@ -78,6 +78,10 @@ VehicleState make_state(const VehicleModel& model, const ResetSettings& reset);
 void set_thruster_efficiency(const VehicleModel& model, VehicleState& state,
                              const ThrusterVector& efficiency);
 
+/// Sets the constant part of the water current on a live vehicle (NED, m/s), from the next step
+/// on; the varying Gauss-Markov part is kept. Throws std::invalid_argument on a non-finite value.
+void set_constant_current(VehicleState& state, const Vector3& current_ned_mps);
+
 /// Advances the state by one control step holding thrust_command_n (size num_thrusters, N).
 /// Commands are saturated; thruster delay, lag, slew and efficiency applied; current updated;
 /// the rigid body integrated with the model's integrator (attitude carried as a quaternion

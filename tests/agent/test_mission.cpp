@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "agent/mission.hpp"
@@ -68,7 +69,7 @@ TEST(MissionFile, ReadsEveryKey) {
   const Mission m = read_mission_file(path);
   EXPECT_EQ(m.name, "tour");
   EXPECT_EQ(m.source_file, path);
-  EXPECT_EQ(m.vehicle_path, (dir.path / "../vehicles/nessie7.yaml").string());
+  EXPECT_EQ(m.vehicle_path, (dir.path.parent_path() / "vehicles/nessie7.yaml").string());
   EXPECT_EQ(m.start.position_ned_m, Eigen::Vector3d(0, 0, 5));
   EXPECT_EQ(m.start.euler_rpy_rad, Eigen::Vector3d(0, 0, 3.1));
   ASSERT_EQ(m.waypoints.size(), 2u);
@@ -187,6 +188,16 @@ TEST(MissionFile, RefusesMalformedFilesNamingKeyAndLine) {
 
 TEST(MissionFile, MissingFileIsAnErrorNamingIt) {
   EXPECT_THROW(read_mission_file("/nonexistent/auvrl/mission.yaml"), config::ConfigError);
+}
+
+TEST(MissionFile, DocsMissionsHoldsTheKeysTableAsGenerated) {
+  std::ifstream in(std::string(AUVRL_DOCS_DIR) + "/missions.md");
+  ASSERT_TRUE(in.good());
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string table = config::render_markdown({config::section_doc(mission_table())}, "");
+  EXPECT_NE(text.find(table), std::string::npos)
+      << "docs/missions.md: replace its `mission` table with `auvrl config-doc`'s:\n"
+      << table;
 }
 
 TEST(MissionFile, TableDocumentsEveryKeyWithItsUnit) {

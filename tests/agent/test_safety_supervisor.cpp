@@ -71,6 +71,16 @@ TEST(SafetySupervisor, NonFiniteStatesAndOutputsGetZeroThrust) {
   EXPECT_EQ(s.state(), SupervisorState::kActive);
 }
 
+TEST(SafetySupervisor, AStateItsSenderDistrustsGetsZeroThrust) {
+  SafetySupervisor s(3, false);
+  s.on_state(0.0, level(), std::nullopt);
+  s.on_action(0.0, action(0.5));
+  EXPECT_EQ(s.on_unusable_state(0.1, "the vehicle reports status 2"), ThrustSource::kZero);
+  EXPECT_EQ(s.state(), SupervisorState::kNonFinite);
+  EXPECT_EQ(s.reason(), "the vehicle reports status 2");
+  EXPECT_EQ(s.counters().non_finite_states, 1);
+}
+
 TEST(SafetySupervisor, LeavingTheLimitsAbortsForGoodWithTheReason) {
   for (const bool surface : {false, true}) {
     SafetySupervisor s(3, surface);

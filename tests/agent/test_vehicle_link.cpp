@@ -1,10 +1,13 @@
 // Both vehicle links start an episode where EpisodeStart says: pose and body velocities (the
-// exploring starts of training depend on it), in this process and through auv_sim's server
-// over the in-process transport.
+// exploring starts of training depend on it) and sensor noise, in this process and through
+// auv_sim's server over the in-process transport; only the in-process link takes a mission's
+// events mid-run.
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "agent/vehicle_link.hpp"
 #include "common/transport.hpp"
@@ -73,6 +76,34 @@ TEST(VehicleLink, LockstepLinkSendsThePoseAndVelocityToTheSimulator) {
   expect_starts_moving(*link);
   ASSERT_NE(server.vehicle(0), nullptr);
   EXPECT_EQ(server.vehicle(0)->step_count, 0);  // reset last
+}
+
+TEST(VehicleLink, BothLinksDrawTheStartsSensorNoiseOnlyInProcessTakesEventsMidRun) {
+  const sim::VehicleModel model = nessie();
+  EpisodeStart start = moving_start();
+  start.sensor_noise.position_sigma_m = 0.5;
+  start.seed = 7;
+  std::unique_ptr<VehicleLink> in_process = make_in_process_link(model);
+  const std::optional<VehicleReport> local = in_process->reset(start);
+  ASSERT_TRUE(local.has_value());
+  EXPECT_GT((local->observation.position_ned_m - start.position_ned_m).norm(), 1e-3);
+
+  std::unique_ptr<transport::Transport> bus = transport::make_in_process_transport();
+  sim::SimServerConfig config;
+  config.heartbeat_period_s = 3600;
+  sim::SimServer server(model, *bus, config);
+  std::unique_ptr<VehicleLink> lockstep = make_lockstep_link(*bus, 0, model.facts());
+  const std::optional<VehicleReport> remote = lockstep->reset(start);
+  ASSERT_TRUE(remote.has_value());
+  // The same noise from the same seed: the wire carries the sigmas.
+  EXPECT_TRUE(remote->observation.position_ned_m.isApprox(local->observation.position_ned_m, 1e-9));
+
+  EXPECT_TRUE(in_process->set_thruster_efficiency(std::vector<double>(6, 0.5)));
+  EXPECT_TRUE(in_process->set_current(Eigen::Vector3d(0.1, 0.0, 0.0)));
+  EXPECT_THROW(in_process->set_thruster_efficiency(std::vector<double>(6, 1.5)),
+               std::invalid_argument);
+  EXPECT_FALSE(lockstep->set_thruster_efficiency(std::vector<double>(6, 0.5)));
+  EXPECT_FALSE(lockstep->set_current(Eigen::Vector3d(0.1, 0.0, 0.0)));
 }
 
 TEST(VehicleLink, LockstepLinkRefusesAnotherVehicleNamingBoth) {

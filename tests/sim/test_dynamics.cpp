@@ -421,6 +421,26 @@ TEST(Current, PassiveVehicleDriftsWithTheWater) {
   EXPECT_LT(previous_gap, 0.02);
 }
 
+TEST(Current, SetOnALiveVehicleActsFromTheNextStepAsAtAReset) {
+  // A current set mid-run (a mission's event) gives the same motion as one set at the reset,
+  // and keeps the varying Gauss-Markov part.
+  const VehicleModel& m = nessie();
+  ResetSettings reset = reset_at_depth(50);
+  reset.current.gauss_markov_speed_mean_mps = 0.1;
+  VehicleState live = make_state(m, reset);
+  reset.current.constant_velocity_ned_mps << 0.2, -0.1, 0.0;
+  VehicleState from_reset = make_state(m, reset);
+  set_constant_current(live, reset.current.constant_velocity_ned_mps);
+  EXPECT_EQ(live.current_velocity_ned_mps, from_reset.current_velocity_ned_mps);
+  for (int k = 0; k < 50; ++k) {
+    step_ideal_thrusters(m, live, zero_thrust(m));
+    step_ideal_thrusters(m, from_reset, zero_thrust(m));
+  }
+  EXPECT_EQ(live.eta, from_reset.eta);
+  EXPECT_EQ(live.nu, from_reset.nu);
+  EXPECT_THROW(set_constant_current(live, Vector3(std::nan(""), 0.0, 0.0)), std::invalid_argument);
+}
+
 TEST(Current, GaussMarkovSpeedHasTheDesignedStatistics) {
   // V_{k+1} - mu = a (V_k - mu) + sigma sqrt(dt) n_k, a = 1 - dt / T: stationary variance
   // sigma^2 dt / (1 - a^2). 200k steps over T = 5 s: ~2000 independent samples, so the

@@ -1,0 +1,257 @@
+#include "tools/export/c_header.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace auvrl::tools {
+
+std::string c_float_literal(float value) {
+  if (!std::isfinite(value)) {
+    throw std::invalid_argument("a network parameter is not finite: cannot export it");
+  }
+  std::string s = fmt::format("{}", value);  // shortest form that reads back to the same float
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s + "f";
+}
+
+namespace {
+
+/// A double as a C double literal that reads back to the same value ("10.0", "39.24").
+std::string c_double_literal(double value) {
+  std::string s = fmt::format("{}", value);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// Text as the lines of a C block comment (" * line"); "*/" cannot end the comment early.
+std::string comment_lines(const std::string& text) {
+  std::string out = " * ";
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      out += i + 1 < text.size() ? "\n * " : "\n";
+    } else if (c == '/' && i > 0 && text[i - 1] == '*') {
+      out += " /";
+    } else {
+      out += c;
+    }
+  }
+  while (out.find(" \n") != std::string::npos) out.replace(out.find(" \n"), 2, "\n");
+  return out;
+}
+
+/// The header's opening comment: what it holds and how a vehicle uses it.
+std::string opening_comment(const ExportedPolicy& policy) {
+  const std::string use =
+      "Exported by `auvrl export --format c` (docs/export.md): a self-contained C99 header, no\n"
+      "dependency beyond <math.h> (link with -lm); every function is static inline.\n"
+      "\n" +
+      describe_policy(policy) +
+      "\n"
+      "Use, every control step (" +
+      fmt::format("{} s", policy.vehicle.control_step_s) +
+      "), as auvrl's episode does:\n"
+      "  auvrl_nav nav;          (the vehicle's navigation data, SI units, see below)\n"
+      "  double goal_ned_m[3];   (the way-point, NED, m)\n"
+      "  float previous[AUVRL_POLICY_NUM_ACTIONS];  (zeros at the start, then the last action)\n"
+      "  float state[AUVRL_POLICY_STATE_DIM], action[AUVRL_POLICY_NUM_ACTIONS];\n"
+      "  auvrl_policy_build_state(&nav, goal_ned_m, previous, state);\n"
+      "  auvrl_policy_act(state, action);\n"
+      "  thrust command of thruster i (N) = action[i] * AUVRL_POLICY_MAX_THRUST_N;\n"
+      "  copy action into previous.\n";
+  return "/* auvrl_policy.h: a trained auvrl policy.\n *\n" + comment_lines(use) + " */\n";
+}
+
+/// Size, scale and thruster-name macros.
+std::string macros(const ExportedPolicy& policy) {
+  const nn::MlpSpec& spec = policy.network.spec();
+  int width = 1;
+  for (int h : spec.hidden) width = std::max(width, h);
+  const task::ObservationScales& k = policy.task.scales;
+  std::string out = fmt::format(
+      "#define AUVRL_POLICY_LAYOUT \"{}\"\n"
+      "#define AUVRL_POLICY_STATE_DIM {}\n"
+      "#define AUVRL_POLICY_NUM_ACTIONS {}\n"
+      "#define AUVRL_POLICY_NUM_THRUSTERS {}\n"
+      "#define AUVRL_POLICY_NUM_PARAMS {}\n"
+      "#define AUVRL_POLICY_MAX_WIDTH {}\n"
+      "/* Action +-1 = +- this thrust, N. */\n"
+      "#define AUVRL_POLICY_MAX_THRUST_N {}\n"
+      "/* Scales: a state entry is the quantity divided by its scale. */\n"
+      "#define AUVRL_POLICY_SCALE_POSITION_M {}\n"
+      "#define AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS {}\n"
+      "#define AUVRL_POLICY_SCALE_ANGULAR_RATE_RAD_S {}\n"
+      "#define AUVRL_POLICY_SCALE_DEPTH_M {}\n"
+      "/* Thruster i's name (action i). */\n",
+      task::to_string(policy.task.layout), spec.input_dim, spec.output_dim,
+      policy.vehicle.num_thrusters(), policy.network.num_params(), width,
+      c_double_literal(policy.task.max_thrust_n), c_double_literal(k.position_m),
+      c_double_literal(k.linear_velocity_mps), c_double_literal(k.angular_rate_rad_s),
+      c_double_literal(k.depth_m));
+  for (int i = 0; i < policy.vehicle.num_thrusters(); ++i) {
+    out += fmt::format("#define AUVRL_POLICY_THRUSTER_{}_NAME \"{}\"\n", i,
+                       policy.vehicle.thruster_names[static_cast<std::size_t>(i)]);
+  }
+  return out;
+}
+
+/// The parameter array, six values a line.
+std::string params_array(const ExportedPolicy& policy) {
+  const auto params = policy.network.params();
+  std::string out =
+      "/* Every parameter of the network, float32, in auvrl's layout (nn::Mlp::params()): each\n"
+      " * layer's weight matrix (out x in, column-major: W[o][i] at offset + i * out + o), layer\n"
+      " * 0 first, then each layer's bias. */\n"
+      "static const float auvrl_policy_params[AUVRL_POLICY_NUM_PARAMS] = {\n";
+  for (Eigen::Index i = 0; i < params.size(); ++i) {
+    out += (i % 6 == 0 ? "    " : " ") + c_float_literal(params[i]) + ",";
+    if (i % 6 == 5 || i + 1 == params.size()) out += "\n";
+  }
+  return out + "};\n";
+}
+
+/// The layer function and auvrl_policy_act, one call per weight layer.
+std::string act_function(const ExportedPolicy& policy) {
+  const nn::MlpSpec& spec = policy.network.spec();
+  std::string out =
+      "/* One weight layer: out = activation(W in + b); activation 0 identity, 1 ReLU, 2 tanh.\n"
+      " * The sums are taken in double (a product of two floats is exact in double), so each\n"
+      " * layer's output is W in + b rounded once to float. */\n"
+      "static inline void auvrl_policy_layer_(int n_in, int n_out, const float *w, const float "
+      "*b,\n"
+      "                                       int activation, const float *in, float *out) {\n"
+      "  int i, o;\n"
+      "  for (o = 0; o < n_out; ++o) {\n"
+      "    double sum = (double)b[o];\n"
+      "    float z;\n"
+      "    for (i = 0; i < n_in; ++i) sum += (double)w[i * n_out + o] * (double)in[i];\n"
+      "    z = (float)sum;\n"
+      "    out[o] = activation == 1 ? (z > 0.0f ? z : 0.0f) : activation == 2 ? tanhf(z) : z;\n"
+      "  }\n"
+      "}\n\n"
+      "/* The policy: state (AUVRL_POLICY_STATE_DIM floats, see auvrl_policy_build_state) ->\n"
+      " * action (AUVRL_POLICY_NUM_ACTIONS floats in [-1, 1]). state and action must not\n"
+      " * overlap. Uses 2 x AUVRL_POLICY_MAX_WIDTH floats of stack. */\n"
+      "static inline void auvrl_policy_act(const float *state, float *action) {\n";
+  const int layers = spec.num_layers();
+  const int buffers = std::min(layers - 1, 2);
+  for (int b = 0; b < buffers; ++b) out += fmt::format("  float h{}[AUVRL_POLICY_MAX_WIDTH];\n", b);
+  for (int l = 0; l < layers; ++l) {
+    const std::string in = l == 0 ? "state" : fmt::format("h{}", (l - 1) % 2);
+    const std::string dst = l + 1 == layers ? "action" : fmt::format("h{}", l % 2);
+    const float* base = policy.network.params().data();
+    out += fmt::format(
+        "  auvrl_policy_layer_({}, {}, auvrl_policy_params + {}, auvrl_policy_params + {}, {},\n"
+        "                      {}, {});\n",
+        spec.layer_in(l), spec.layer_out(l), policy.network.weight(l).data() - base,
+        policy.network.bias(l).data() - base, static_cast<int>(spec.layer_activation(l)), in, dst);
+  }
+  return out + "}\n";
+}
+
+/// The navigation data struct.
+std::string nav_struct(const ExportedPolicy& policy) {
+  const bool thrust = policy.task.layout == task::StateLayout::kExtendedThrust;
+  return std::string(
+             "/* The vehicle's navigation data, as auvrl's task::Observation (frames: NED world,\n"
+             " * x north, y east, z down; body, x forward, y starboard, z down). */\n"
+             "typedef struct auvrl_nav {\n"
+             "  double position_ned_m[3];          /* north, east, down, m */\n"
+             "  double euler_rpy_rad[3];           /* roll, pitch, yaw (ZYX Euler), rad */\n"
+             "  double velocity_body_mps[3];       /* u, v, w, m/s */\n"
+             "  double angular_rate_body_rad_s[3]; /* p, q, r, rad/s */\n"
+             "  /* Thrust each thruster produces now (as the vehicle reports it), N; ") +
+         (thrust ? "read by this layout. */\n" : "not read by this layout. */\n") +
+         "  double thrust_realised_n[AUVRL_POLICY_NUM_THRUSTERS];\n"
+         "} auvrl_nav;\n";
+}
+
+/// The paper layout's body of auvrl_policy_build_state.
+std::string paper_state_body() {
+  return "  int i;\n"
+         "  for (i = 0; i < 3; ++i) {\n"
+         "    const double error_ned = goal_ned_m[i] - nav->position_ned_m[i];\n"
+         "    state[i] = (float)(nav->position_ned_m[i] / AUVRL_POLICY_SCALE_POSITION_M);\n"
+         "    state[3 + i] = (float)(error_ned / AUVRL_POLICY_SCALE_POSITION_M);\n"
+         "    state[6 + i] = (float)(nav->velocity_body_mps[i] / "
+         "AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS);\n"
+         "    state[9 + i] = (float)(nav->angular_rate_body_rad_s[i] / "
+         "AUVRL_POLICY_SCALE_ANGULAR_RATE_RAD_S);\n"
+         "  }\n"
+         "  for (i = 0; i < AUVRL_POLICY_NUM_THRUSTERS; ++i) state[12 + i] = previous_action[i];\n";
+}
+
+/// The extended layouts' body of auvrl_policy_build_state.
+std::string extended_state_body(bool with_thrust) {
+  std::string out =
+      "  const double *e = nav->euler_rpy_rad;\n"
+      "  const double cphi = cos(e[0]), sphi = sin(e[0]);\n"
+      "  const double cth = cos(e[1]), sth = sin(e[1]);\n"
+      "  const double cpsi = cos(e[2]), spsi = sin(e[2]);\n"
+      "  /* Body-to-NED rotation R (Fossen's R(Theta), ZYX); the body-frame error is R^T e. */\n"
+      "  const double r[3][3] = {\n"
+      "      {cpsi * cth, -spsi * cphi + cpsi * sth * sphi, spsi * sphi + cpsi * cphi * sth},\n"
+      "      {spsi * cth, cpsi * cphi + sphi * sth * spsi, -cpsi * sphi + sth * spsi * cphi},\n"
+      "      {-sth, cth * sphi, cth * cphi}};\n"
+      "  double error_ned[3];\n"
+      "  int i;\n"
+      "  for (i = 0; i < 3; ++i) error_ned[i] = goal_ned_m[i] - nav->position_ned_m[i];\n"
+      "  for (i = 0; i < 3; ++i) {\n"
+      "    const double body = r[0][i] * error_ned[0] + r[1][i] * error_ned[1] + r[2][i] * "
+      "error_ned[2];\n"
+      "    state[i] = (float)(body / AUVRL_POLICY_SCALE_POSITION_M);\n"
+      "    state[4 + 2 * i] = (float)sin(e[i]);\n"
+      "    state[5 + 2 * i] = (float)cos(e[i]);\n"
+      "    state[10 + i] =\n"
+      "        (float)(nav->velocity_body_mps[i] / AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS);\n"
+      "    state[13 + i] =\n"
+      "        (float)(nav->angular_rate_body_rad_s[i] / AUVRL_POLICY_SCALE_ANGULAR_RATE_RAD_S);\n"
+      "  }\n"
+      "  state[3] = (float)(sqrt(error_ned[0] * error_ned[0] + error_ned[1] * error_ned[1] +\n"
+      "                          error_ned[2] * error_ned[2]) /\n"
+      "                     AUVRL_POLICY_SCALE_POSITION_M);\n"
+      "  for (i = 0; i < AUVRL_POLICY_NUM_THRUSTERS; ++i) state[16 + i] = previous_action[i];\n"
+      "  state[16 + AUVRL_POLICY_NUM_THRUSTERS] =\n"
+      "      (float)(nav->position_ned_m[2] / AUVRL_POLICY_SCALE_DEPTH_M);\n";
+  if (with_thrust) {
+    out +=
+        "  for (i = 0; i < AUVRL_POLICY_NUM_THRUSTERS; ++i) {\n"
+        "    state[17 + AUVRL_POLICY_NUM_THRUSTERS + i] =\n"
+        "        (float)(nav->thrust_realised_n[i] / AUVRL_POLICY_MAX_THRUST_N);\n"
+        "  }\n";
+  }
+  return out;
+}
+
+/// auvrl_policy_build_state for the policy's layout.
+std::string build_state_function(const ExportedPolicy& policy) {
+  const task::StateLayout layout = policy.task.layout;
+  std::string out = fmt::format(
+      "/* The state vector of the {} layout (the list at the top of this file),\n"
+      " * from the vehicle's navigation data, the way-point (NED, m) and the previous action\n"
+      " * (zeros at the start): auvrl's task::build_state with the scales above, computed in\n"
+      " * double and stored as float. */\n"
+      "static inline void auvrl_policy_build_state(const auvrl_nav *nav, const double "
+      "goal_ned_m[3],\n"
+      "                                            const float *previous_action, float *state) "
+      "{{\n",
+      task::to_string(layout));
+  out += layout == task::StateLayout::kPaper
+             ? paper_state_body()
+             : extended_state_body(layout == task::StateLayout::kExtendedThrust);
+  return out + "}\n";
+}
+
+}  // namespace
+
+std::string policy_c_header(const ExportedPolicy& policy) {
+  return opening_comment(policy) +
+         "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
+         macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
+         nav_struct(policy) + "\n" + build_state_function(policy) +
+         "\n#endif /* AUVRL_POLICY_H */\n";
+}
+
+}  // namespace auvrl::tools
