@@ -5,13 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "common/csv.hpp"
-
 namespace auvrl::launcher {
 
 namespace {
-
-constexpr int kCsvDigits = 9;
 
 task::Observation observation_of(const auvrl_lcm::vehicle_state_t& msg) {
   task::Observation o;
@@ -103,53 +99,35 @@ double MissionRecorder::mission_wall_s() const {
   return states_.back().wall_s - states_[first].wall_s;
 }
 
-std::vector<WaypointRow> analyse_waypoints(const std::vector<agent::MissionWaypoint>& waypoints,
-                                           std::vector<agent::TrajectoryRow>& rows,
-                                           double max_thrust_n) {
+MissionAnalysis analyse_waypoints(const std::vector<agent::MissionWaypoint>& waypoints,
+                                  std::vector<agent::TrajectoryRow>& rows, double max_thrust_n) {
   agent::MissionTracker tracker(waypoints);
-  std::vector<WaypointRow> out(waypoints.size());
+  MissionAnalysis out;
+  out.waypoints.resize(waypoints.size());
   for (std::size_t i = 0; i < waypoints.size(); ++i) {
-    out[i].number = static_cast<int>(i) + 1;
-    out[i].waypoint = waypoints[i];
+    out.waypoints[i].index = static_cast<int>(i);
+    out.waypoints[i].waypoint = waypoints[i];
   }
   for (agent::TrajectoryRow& row : rows) {
-    // The way-point current at this row (the last one once the mission is done).
+    // The way-point current before this row (the last one once the mission is done).
+    const int current = std::min(tracker.index(), tracker.count() - 1);
     row.distance_m = (tracker.goal_ned_m() - row.observation.position_ned_m).norm();
-    const auto current = static_cast<std::size_t>(tracker.index());
-    if (current < out.size() && !row.thrust_command_n.empty()) {
+    out.waypoint_index.push_back(current);
+    if (!tracker.done() && !row.thrust_command_n.empty()) {
       double sum = 0.0;
       for (double f : row.thrust_command_n) sum += (f / max_thrust_n) * (f / max_thrust_n);
-      out[current].energy += sum / static_cast<double>(row.thrust_command_n.size());
-      ++out[current].steps;
+      out.waypoints[static_cast<std::size_t>(current)].thrust_energy +=
+          sum / static_cast<double>(row.thrust_command_n.size());
     }
     tracker.update(row.time_s, row.observation.position_ned_m);
   }
-  for (std::size_t i = 0; i < out.size(); ++i) out[i].result = tracker.results()[i];
+  for (std::size_t i = 0; i < out.waypoints.size(); ++i) {
+    out.waypoints[i].result = tracker.results()[i];
+  }
   return out;
 }
 
-void write_waypoints_csv(const std::string& path, const std::vector<WaypointRow>& rows) {
-  csv::Writer out(path,
-                  {"index", "x", "y", "z", "reached", "time_to_reach_s", "hold_error_m", "energy",
-                   "time_from_previous_s", "completed_s"},
-                  csv::Mode::kTruncate, kCsvDigits);
-  const auto time_or_empty = [&out](double v) -> csv::Writer& {
-    return v < 0 ? out.empty() : out.cell(v);
-  };
-  for (const WaypointRow& r : rows) {
-    const Eigen::Vector3d& p = r.waypoint.position_ned_m;
-    out.cell(r.number).cell(p.x()).cell(p.y()).cell(p.z()).cell(r.result.reached);
-    time_or_empty(r.result.time_to_reach_s);
-    time_or_empty(r.result.hold_error_m);
-    out.cell(r.energy);
-    time_or_empty(r.result.time_from_previous_s);
-    time_or_empty(r.result.completed_time_s);
-    out.end_row();
-  }
-  out.flush();
-}
-
-std::string format_waypoint_table(const std::vector<WaypointRow>& rows) {
+std::string format_waypoint_table(const std::vector<eval::MissionWaypointRow>& rows) {
   const auto value = [](double v, int decimals) {
     return v < 0 ? std::string("-") : fmt::format("{:.{}f}", v, decimals);
   };
@@ -157,12 +135,12 @@ std::string format_waypoint_table(const std::vector<WaypointRow>& rows) {
       "| way-point | x, y, z (m) | reached | time to reach (s) | from previous (s) | hold error "
       "(m) | energy |\n"
       "|---|---|---|---|---|---|---|\n";
-  for (const WaypointRow& r : rows) {
+  for (const eval::MissionWaypointRow& r : rows) {
     const Eigen::Vector3d& p = r.waypoint.position_ned_m;
-    out += fmt::format("| {} | {:g}, {:g}, {:g} | {} | {} | {} | {} | {:.1f} |\n", r.number, p.x(),
-                       p.y(), p.z(), r.result.reached ? "yes" : "no",
+    out += fmt::format("| {} | {:g}, {:g}, {:g} | {} | {} | {} | {} | {:.1f} |\n", r.index + 1,
+                       p.x(), p.y(), p.z(), r.result.reached ? "yes" : "no",
                        value(r.result.time_to_reach_s, 1), value(r.result.time_from_previous_s, 1),
-                       value(r.result.hold_error_m, 3), r.energy);
+                       value(r.result.hold_error_m, 3), r.thrust_energy);
   }
   return out;
 }

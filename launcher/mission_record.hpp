@@ -1,8 +1,9 @@
 // What `auvrl run` records while a mission runs (every SIM_STATE_<id>, SIM_CMD_<id> and
 // MISSION_STATUS) and what it makes of it afterwards: the trajectory from the controller's
 // first state on, and one row per way-point computed by feeding a MissionTracker (the one
-// auv_controller uses) with the recorded states. No processes and no transport here: tests feed
-// messages directly.
+// auv_controller uses) with the recorded states, in the in-process evaluation's form
+// (eval/mission_run.hpp: waypoints.csv is its mission.csv). No processes and no transport here:
+// tests feed messages directly.
 #pragma once
 
 #include <auvrl_lcm/mission_status_t.hpp>
@@ -14,6 +15,7 @@
 
 #include "agent/episode.hpp"
 #include "agent/mission.hpp"
+#include "eval/mission_run.hpp"
 
 namespace auvrl::launcher {
 
@@ -68,32 +70,23 @@ class MissionRecorder {
   std::optional<double> start_estimate_s_;
 };
 
-/// What became of one way-point of a mission run (waypoints.csv, the report's table).
-struct WaypointRow {
-  int number = 0;  ///< from 1, as "way-point i of n"
-  agent::MissionWaypoint waypoint;
-  agent::WaypointResult result;
-  /// Sum over the control steps while it was the current way-point of the mean squared
-  /// normalised command (six thrusters at full thrust for 10 s give 100).
-  double energy = 0.0;
-  int steps = 0;  ///< control steps while it was the current way-point
+/// The record of a mission as the in-process evaluation (`auvrl eval --mission`) gives it: one
+/// row per way-point, and per trajectory row the way-point the vehicle was driving to.
+struct MissionAnalysis {
+  std::vector<eval::MissionWaypointRow> waypoints;
+  std::vector<int> waypoint_index;  ///< per trajectory row, from 0 (write_trajectory_csv)
 };
 
-/// Feeds a MissionTracker with the rows (times since the mission start) and returns one row per
-/// way-point; sets each trajectory row's distance_m to the way-point current at that row.
-std::vector<WaypointRow> analyse_waypoints(const std::vector<agent::MissionWaypoint>& waypoints,
-                                           std::vector<agent::TrajectoryRow>& rows,
-                                           double max_thrust_n);
+/// Feeds a MissionTracker (the one auv_controller uses) with the rows (times since the mission
+/// start), as the evaluation does: each row's command counts for the way-point current before
+/// the row (the one it drove to), and its distance_m is set to that way-point. Energy: sum over
+/// the rows while a way-point was current of the mean squared normalised command (max_thrust_n
+/// is 1); none once the mission is done.
+MissionAnalysis analyse_waypoints(const std::vector<agent::MissionWaypoint>& waypoints,
+                                  std::vector<agent::TrajectoryRow>& rows, double max_thrust_n);
 
-/// Writes waypoints.csv: index (from 1), x, y, z (NED, m), reached (0/1), time_to_reach_s
-/// (first time within the radius as the current way-point, s since the mission start; empty if
-/// never), hold_error_m (mean distance from that arrival to its completion, m; empty if never),
-/// energy, time_from_previous_s (from the previous way-point's completion; empty if never),
-/// completed_s (when its hold ended; empty if never). Throws std::runtime_error naming the path
-/// on failure.
-void write_waypoints_csv(const std::string& path, const std::vector<WaypointRow>& rows);
-
-/// The per-way-point table (Markdown, readable on a terminal too).
-std::string format_waypoint_table(const std::vector<WaypointRow>& rows);
+/// The per-way-point table (Markdown, readable on a terminal too), the way-points numbered from
+/// 1 as "way-point i of n" (waypoints.csv's index is from 0).
+std::string format_waypoint_table(const std::vector<eval::MissionWaypointRow>& rows);
 
 }  // namespace auvrl::launcher

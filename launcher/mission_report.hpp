@@ -34,7 +34,7 @@ struct MissionRunSummary {
   std::vector<std::string> not_applied;  ///< events that could not be applied, and why
   /// auv_sim's faults_total from its last heartbeat (live faults it applied); none if unheard.
   std::optional<std::int64_t> sim_faults_total;
-  std::vector<WaypointRow> waypoints;
+  std::vector<eval::MissionWaypointRow> waypoints;
   std::string plots_note;  ///< empty when the plots were drawn; otherwise why not
 };
 

@@ -23,6 +23,7 @@
 #include "common/transport.hpp"
 #include "common/vehicle_facts.hpp"
 #include "eval/evaluation.hpp"
+#include "eval/mission_run.hpp"
 #include "launcher/mission_record.hpp"
 #include "launcher/mission_report.hpp"
 #include "launcher/namespace_exec.hpp"
@@ -42,6 +43,8 @@ constexpr double kStateSilenceS = 5.0;     ///< no state this long (wall-clock):
 constexpr double kControllerGraceS = 3.0;  ///< SIGTERM to SIGKILL, s
 constexpr double kSimGraceS = 3.0;
 constexpr double kLoggerGraceS = 10.0;
+/// Mission times are differences of vehicle clocks: 6.0 may come out as 5.9999999.
+constexpr double kTimeToleranceS = 1e-6;
 
 std::string absolute(const std::string& path) {
   return path.empty() ? path : fs::absolute(path).lexically_normal().string();
@@ -111,8 +114,10 @@ void write_mission_readme(const MissionRunOptions& o) {
   std::ofstream out(fs::path(o.run_dir) / "README.txt");
   out << "auvrl run directory (a mission flown by auv_controller on auv_sim --realtime)\n"
       << "  mission.yaml      a copy of " << o.mission_path << "\n"
-      << "  trajectory.csv    every state from the mission start, with the command in force\n"
-      << "  waypoints.csv     one row per way-point: reached, time to reach, hold error, energy\n"
+      << "  trajectory.csv    every state from the mission start, with the command in force and\n"
+      << "                    the way-point driven to (auvrl eval --mission's trajectory format)\n"
+      << "  waypoints.csv     one row per way-point, index from 0: reached, time to reach, hold\n"
+      << "                    error, energy (auvrl eval --mission's mission.csv format)\n"
       << "  vehicle.csv       the vehicle and its thrusters (names for the plots)\n"
       << "  events.csv        the mission's events as applied, with their mission time\n"
       << "  report.md         the table, times, real-time factor, supervisor, events, plots\n"
@@ -367,7 +372,8 @@ void MissionSession::inject_due_events() {
   const std::optional<double> t = recorder_.mission_time_s();
   if (!t) return;
   const std::vector<agent::MissionEvent>& events = mission_.events;
-  for (; next_event_ < events.size() && events[next_event_].time_s <= *t; ++next_event_) {
+  for (; next_event_ < events.size() && events[next_event_].time_s <= *t + kTimeToleranceS;
+       ++next_event_) {
     const agent::MissionEvent& e = events[next_event_];
     if (e.kind != agent::MissionEvent::Kind::kThrusterEfficiency) continue;
     efficiency_[static_cast<std::size_t>(e.thruster)] = e.efficiency;
@@ -444,7 +450,7 @@ std::optional<MissionEnd> MissionSession::watch() {
   if (signals::stop_requested()) return MissionEnd{kMissionStopped, "stopped by the user"};
   if (!controller_->running()) return controller_ended();
   const std::optional<double> t = recorder_.mission_time_s();
-  if (t && *t >= mission_.time_limit_s) {
+  if (t && *t + kTimeToleranceS >= mission_.time_limit_s) {
     return MissionEnd{kMissionTimeLimit,
                       fmt::format("the mission's time limit of {:g} s (vehicle time) passed",
                                   mission_.time_limit_s)};
@@ -485,12 +491,16 @@ int MissionSession::finish(const MissionEnd& end) {
   s.not_applied = not_applied_;
   s.sim_faults_total = sim_faults_total_;
   const VehicleFacts facts = model_.facts();
-  s.waypoints = analyse_waypoints(mission_.waypoints, rows, facts.max_thrust_n);
+  const MissionAnalysis analysis = analyse_waypoints(mission_.waypoints, rows, facts.max_thrust_n);
+  s.waypoints = analysis.waypoints;
   const fs::path dir = options_.run_dir;
   try {
-    eval::write_trajectory_csv((dir / "trajectory.csv").string(), rows, facts.num_thrusters());
+    eval::write_trajectory_csv((dir / "trajectory.csv").string(), rows, facts.num_thrusters(),
+                               &analysis.waypoint_index);
     eval::write_vehicle_csv((dir / "vehicle.csv").string(), facts);
-    write_waypoints_csv((dir / "waypoints.csv").string(), s.waypoints);
+    eval::MissionOutcome outcome;  // write_mission_csv writes its way-points only
+    outcome.waypoints = s.waypoints;
+    eval::write_mission_csv((dir / "waypoints.csv").string(), outcome);
     write_events_csv((dir / "events.csv").string(), s.events);
     s.plots_note = draw_mission_plots(options_);
     write_mission_report(options_, mission_, s);

@@ -5,10 +5,11 @@ Usage: /usr/bin/python3 scripts/plot_mission.py RUN
 
 Reads what `auvrl run` writes into RUN:
   trajectory.csv   t, x, y, z, phi, theta, psi, ..., cmd_1..cmd_n, thrust_1..thrust_n, distance_m
-  waypoints.csv    index, x, y, z, reached, time_to_reach_s, hold_error_m, energy, ...
+  waypoints.csv    index (from 0), x, y, z, reached, time_to_reach_s, ..., completed_s, ...
   vehicle.csv      the thrusters' names (T1, T2, ... without it)
   events.csv       time_s, event: the events injected during the mission (optional)
-and writes RUN/plots/mission_3d.png (the 3-D path through every way-point, numbered) and
+and writes RUN/plots/mission_3d.png (the 3-D path through every way-point, numbered from 1 as
+"way-point i of n") and
 RUN/plots/mission_thrusters.png (each thruster's realised and commanded thrust against time, the
 way-points' completions and the injected events marked).
 
@@ -106,7 +107,7 @@ def plot_3d(traj, waypoints, title, path):
                    marker="*", s=170, depthshade=False,
                    label=None if label in labelled else label)
         labelled.add(label)
-        ax.text(wp[i][0], wp[i][1], wp[i][2], f"  {w.get('index', i + 1)}", fontsize=11,
+        ax.text(wp[i][0], wp[i][1], wp[i][2], f"  {i + 1}", fontsize=11,
                 fontweight="bold", color="darkred" if reached else "0.35")
     ax.set_xlabel("east y [m]", labelpad=2)
     ax.set_ylabel("north x [m]", labelpad=2)
@@ -124,7 +125,7 @@ def plot_thrusters(traj, names, waypoints, events, title, path):
     t = traj["t"]
     fig, axes = plt.subplots(len(names), 1, figsize=(10, 1.35 * len(names) + 1.4), sharex=True,
                              sharey=True, squeeze=False)
-    done = [(number(w.get("completed_s")), w.get("index", "")) for w in waypoints]
+    done = [(number(w.get("completed_s")), i + 1) for i, w in enumerate(waypoints)]
     for i, name in enumerate(names):
         ax = axes[i][0]
         cmd, real = traj.get(f"cmd_{i + 1}"), traj.get(f"thrust_{i + 1}")

@@ -91,9 +91,10 @@ TEST(AnalyseWaypoints, FeedsTheTrackerAndSumsTheEnergyOfEachWaypoint) {
     r.thrust_realised_n = {20.0, 0.0};
     rows.push_back(r);
   }
-  const auto result = launcher::analyse_waypoints(waypoints, rows, 40.0);
+  const launcher::MissionAnalysis analysis = launcher::analyse_waypoints(waypoints, rows, 40.0);
+  const auto& result = analysis.waypoints;
   ASSERT_EQ(result.size(), 2u);
-  EXPECT_EQ(result[0].number, 1);
+  EXPECT_EQ(result[0].index, 0);
   EXPECT_TRUE(result[0].result.reached);
   EXPECT_NEAR(result[0].result.time_to_reach_s, 1.5, 1e-9);
   EXPECT_NEAR(result[0].result.completed_time_s, 2.5, 1e-9);
@@ -101,10 +102,12 @@ TEST(AnalyseWaypoints, FeedsTheTrackerAndSumsTheEnergyOfEachWaypoint) {
   EXPECT_NEAR(result[1].result.time_to_reach_s, 4.6, 1e-9);
   EXPECT_NEAR(result[1].result.time_from_previous_s, 2.1, 1e-9);
   // Energy: 0.125 per control step while it was the current way-point (none once done).
-  EXPECT_EQ(result[0].steps, 26);  // t = 0 .. 2.5
-  EXPECT_EQ(result[1].steps, 21);  // t = 2.6 .. 4.6
-  EXPECT_NEAR(result[0].energy, 0.125 * result[0].steps, 1e-9);
-  EXPECT_NEAR(result[1].energy, 0.125 * result[1].steps, 1e-9);
+  EXPECT_NEAR(result[0].thrust_energy, 0.125 * 26, 1e-9);  // rows t = 0 .. 2.5
+  EXPECT_NEAR(result[1].thrust_energy, 0.125 * 21, 1e-9);  // rows t = 2.6 .. 4.6
+  ASSERT_EQ(analysis.waypoint_index.size(), rows.size());
+  EXPECT_EQ(analysis.waypoint_index[25], 0);
+  EXPECT_EQ(analysis.waypoint_index[26], 1);
+  EXPECT_EQ(analysis.waypoint_index[60], 1);  // done: the last one
   EXPECT_NEAR(rows[0].distance_m, 2.0, 1e-9);
   EXPECT_NEAR(rows[40].distance_m, 5.05 - rows[40].observation.position_ned_m.x(), 1e-9);
   const std::string table = launcher::format_waypoint_table(result);
