@@ -30,7 +30,7 @@ std::string controller_text(const MissionRunOptions& o) {
 void write_times(std::ostream& md, const MissionRunOptions& o, const MissionRunSummary& s) {
   md << "## Time\n\n"
      << "| | |\n|---|---|\n"
-     << fmt::format("| wall-clock, the whole command | {:.1f} s |\n", s.wall_s)
+     << fmt::format("| wall-clock, first process started to last stopped | {:.1f} s |\n", s.wall_s)
      << fmt::format("| wall-clock, the mission (its first state to its last) | {:.1f} s |\n",
                     s.mission_wall_s)
      << fmt::format("| vehicle time, the mission | {:.1f} s |\n", s.vehicle_time_s)
