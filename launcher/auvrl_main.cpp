@@ -224,7 +224,8 @@ int run_mission_command(int argc, const char* const* argv) {
       "auv_logger, in a private network namespace: shows its progress, injects its timed\n"
       "thruster faults live, stops when the controller exits, the time limit passes or on\n"
       "Ctrl-C, then writes RUN/trajectory.csv, waypoints.csv, vehicle.csv, plots/ and report.md.\n"
-      "Exit: 0 complete, 1 error, 3 aborted by the supervisor, 4 time limit, 130 stopped.");
+      "Exit: 0 complete, 1 error, 2 refused at start, 3 aborted by the supervisor, 4 time limit,\n"
+      "130 stopped.");
   cli.option("mission", &options.mission_path, "mission file (config/missions/*.yaml)");
   cli.require("mission");
   cli.option("policy", &options.policy_path, "policy network file (the nn format)");

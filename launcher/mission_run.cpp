@@ -156,7 +156,13 @@ std::vector<std::string> mission_namespace_command(const MissionRunOptions& o) {
 }
 
 int start_mission_run(MissionRunOptions options, bool host_network, std::ostream& out) {
-  if (!options.prepared) prepare_mission_run(options);
+  if (!options.prepared) {
+    try {
+      prepare_mission_run(options);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(e.what());  // refused before anything started
+    }
+  }
   if (host_network || in_private_namespace()) return run_mission(options, out);
   exec_in_namespace(mission_namespace_command(options));
 }

@@ -4,7 +4,7 @@
 // auv_controller; it shows the mission's progress (MISSION_STATUS), records every state and
 // command, injects the mission's timed thruster faults live (thruster_fault_t on SIM_FAULT_0),
 // and stops when the controller exits, the mission's time limit passes or on Ctrl-C. Then it
-// writes trajectory.csv, vehicle.csv, waypoints.csv, the plots and report.md
+// writes trajectory.csv, vehicle.csv, waypoints.csv, events.csv, the plots and report.md
 // (docs/deployment.md, "auvrl run").
 #pragma once
 
@@ -51,7 +51,8 @@ std::vector<std::string> mission_namespace_command(const MissionRunOptions& opti
 /// `auvrl run` once its options are parsed: prepares the run directory (unless
 /// options.prepared), then runs the mission here when host_network is set or this process
 /// already runs inside a private network namespace (AUVRL_IN_NETNS=1); otherwise runs itself
-/// again inside a new one and does not return. Returns the exit code (MissionRunExit).
+/// again inside a new one and does not return. Returns the exit code (MissionRunExit); throws
+/// std::invalid_argument (auvrl's exit status 2) for anything refused before the run starts.
 int start_mission_run(MissionRunOptions options, bool host_network, std::ostream& out);
 
 /// Runs the prepared mission here (inside the namespace, or with --network host): processes,

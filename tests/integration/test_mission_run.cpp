@@ -159,7 +159,7 @@ TEST(MissionRun, RefusesAnExistingRunAndAPolicyThatDoesNotFitBeforeStarting) {
     argv.insert(argv.end(), extra.begin(), extra.end());
     ChildProcess p(argv, dir + "/refused.log");
     const int status = p.wait_for_exit(std::chrono::seconds(20));
-    EXPECT_NE(exit_code(status), 0) << p.log();
+    EXPECT_EQ(exit_code(status), 2) << p.log();
     EXPECT_NE(p.log().find(expected), std::string::npos) << p.log();
   };
   // dir holds the mission file: not an empty directory.
