@@ -65,8 +65,7 @@ std::unique_ptr<PolicyController> load_policy(const std::string& path,
     throw std::runtime_error(where + ": " + e.what());
   }
   try {
-    return std::make_unique<PolicyController>(std::move(network), task.state_dim(),
-                                              num_thrusters);
+    return std::make_unique<PolicyController>(std::move(network), task.state_dim(), num_thrusters);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + " with the " + task::to_string(task.layout) +
                              " layout: " + e.what());

@@ -1,9 +1,9 @@
 #include "agent/controller_node.hpp"
 
-#include <auvrl_lcm/thruster_cmd_t.hpp>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <auvrl_lcm/thruster_cmd_t.hpp>
 #include <cmath>
 #include <stdexcept>
 
@@ -80,10 +80,8 @@ double ControllerNode::mission_time_s() const {
 
 void ControllerNode::poll(int wait_ms) {
   const auto now = Clock::now();
-  const int until_due = static_cast<int>(
-      std::max<std::int64_t>(0, std::chrono::duration_cast<std::chrono::milliseconds>(
-                                    next_due_ - now)
-                                    .count()));
+  const int until_due = static_cast<int>(std::max<std::int64_t>(
+      0, std::chrono::duration_cast<std::chrono::milliseconds>(next_due_ - now).count()));
   transport_.handle(std::min(wait_ms, until_due));
   if (auto msg = missions_.take()) on_mission(*msg);
   if (auto msg = states_.take()) {
@@ -129,10 +127,10 @@ void ControllerNode::on_state(const auvrl_lcm::vehicle_state_t& msg) {
   const double t = mission_time_s();
   const std::optional<std::string> violation =
       is_finite(observation_) ? check_limits(mission_, observation_) : std::nullopt;
-  ThrustSource source =
-      report.blown_up
-          ? supervisor_.on_unusable_state(t, fmt::format("the vehicle reports status {}", msg.status))
-          : supervisor_.on_state(t, observation_, violation);
+  ThrustSource source = report.blown_up
+                            ? supervisor_.on_unusable_state(
+                                  t, fmt::format("the vehicle reports status {}", msg.status))
+                            : supervisor_.on_state(t, observation_, violation);
   if (source == ThrustSource::kController) {
     const int before = tracker_->index();
     tracker_->update(t, observation_.position_ned_m);
@@ -176,7 +174,8 @@ void ControllerNode::command(ThrustSource source) {
   cmd.num_thrusters = static_cast<std::int8_t>(n);
   cmd.thrust_n.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
-    cmd.thrust_n[static_cast<std::size_t>(i)] = static_cast<double>(commanded_[i]) * task_.max_thrust_n;
+    cmd.thrust_n[static_cast<std::size_t>(i)] =
+        static_cast<double>(commanded_[i]) * task_.max_thrust_n;
   }
   transport::publish(transport_, channels::sim_command(options_.vehicle_id), cmd);
   publish_status();

@@ -25,10 +25,10 @@ namespace auvrl::agent {
 
 /// auv_controller's settings besides the vehicle, the controller and the mission.
 struct ControllerNodeOptions {
-  int vehicle_id = 0;    ///< its vehicle's SIM_STATE_<id> / SIM_CMD_<id>
-  int stale_steps = 3;   ///< control steps without a state that stop the thrusters
-  double speed = 1.0;    ///< the vehicle runs this many times faster than real time
-  std::string name;      ///< "policy" or "pid" (MISSION_STATUS.controller)
+  int vehicle_id = 0;   ///< its vehicle's SIM_STATE_<id> / SIM_CMD_<id>
+  int stale_steps = 3;  ///< control steps without a state that stop the thrusters
+  double speed = 1.0;   ///< the vehicle runs this many times faster than real time
+  std::string name;     ///< "policy" or "pid" (MISSION_STATUS.controller)
 };
 
 /// The deployable controller as a transport participant. Single-threaded.
@@ -38,11 +38,11 @@ class ControllerNode {
   /// std::invalid_argument for an unusable mission or option.
   ControllerNode(const sim::VehicleModel& model, task::TaskConfig task,
                  std::unique_ptr<Controller> controller, Mission mission,
-                 ControllerNodeOptions options, transport::Transport& transport,
-                 std::ostream& log);
+                 ControllerNodeOptions options, transport::Transport& transport, std::ostream& log);
 
   /// Handles messages for up to wait_ms; takes a new mission sent over MISSION_<id>; acts on the
-  /// newest state, or decides a missed control step when one is due. Throws UnrecoverableFault when the state names another vehicle.
+  /// newest state, or decides a missed control step when one is due. Throws UnrecoverableFault when
+  /// the state names another vehicle.
   void poll(int wait_ms);
   /// Replaces the mission (a new one sent to the running controller): the tracker starts over
   /// from its first way-point; an abort stays an abort.
@@ -80,14 +80,14 @@ class ControllerNode {
   transport::Latest<auvrl_lcm::mission_t> missions_;
 
   Clock::duration period_;
-  Clock::time_point next_due_;      ///< when a control step without a state is decided
+  Clock::time_point next_due_;  ///< when a control step without a state is decided
   std::optional<double> first_state_time_s_;
-  double last_state_time_s_ = 0;    ///< the vehicle's clock (sim_time_s) of the newest state
+  double last_state_time_s_ = 0;  ///< the vehicle's clock (sim_time_s) of the newest state
   task::Observation observation_;
   std::vector<double> thrust_realised_n_;
   task::StateVector state_vector_;
-  task::ActionVector action_;       ///< the controller's last output
-  task::ActionVector commanded_;    ///< the last command sent, normalised
+  task::ActionVector action_;     ///< the controller's last output
+  task::ActionVector commanded_;  ///< the last command sent, normalised
   Eigen::VectorXd surface_thrust_n_;
   std::int64_t seq_ = 0;
   std::size_t events_logged_ = 0;

@@ -15,7 +15,7 @@ namespace auvrl::agent {
 ControllerSetup load_controller_setup(const ControllerProcessOptions& options) {
   if (options.mission_path.empty()) throw std::invalid_argument("--mission FILE is required");
   ControllerSetup setup{{}, {}, nullptr, read_mission_file(options.mission_path)};
-  const std::string vehicle = !options.vehicle_path.empty()     ? options.vehicle_path
+  const std::string vehicle = !options.vehicle_path.empty()         ? options.vehicle_path
                               : !setup.mission.vehicle_path.empty() ? setup.mission.vehicle_path
                                                                     : default_vehicle_file();
   setup.model = sim::load_vehicle_file(vehicle);
@@ -67,11 +67,14 @@ int run_controller(ControllerSetup& setup, const ControllerProcessOptions& optio
     }
   }
   const bool aborted = node.supervisor().state() == SupervisorState::kAborted;
-  log << fmt::format("auv_controller: {} after {:.1f} s: way-point {} of {}, supervisor {}{}\n",
-                     aborted ? "aborted" : node.finished() ? "mission complete" : "stopped",
-                     node.tracker().elapsed_s(), node.tracker().index(), node.tracker().count(),
-                     to_string(node.supervisor().state()),
-                     node.supervisor().reason().empty() ? "" : " (" + node.supervisor().reason() + ")");
+  log << fmt::format(
+      "auv_controller: {} after {:.1f} s: way-point {} of {}, supervisor {}{}\n",
+      aborted           ? "aborted"
+      : node.finished() ? "mission complete"
+                        : "stopped",
+      node.tracker().elapsed_s(), node.tracker().index(), node.tracker().count(),
+      to_string(node.supervisor().state()),
+      node.supervisor().reason().empty() ? "" : " (" + node.supervisor().reason() + ")");
   return aborted ? 3 : 0;
 }
 

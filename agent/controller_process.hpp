@@ -14,14 +14,14 @@ namespace auvrl::agent {
 
 /// auv_controller's command line.
 struct ControllerProcessOptions {
-  std::string mission_path;   ///< required
-  std::string policy_path;    ///< the policy's network file (or controller "pid")
+  std::string mission_path;           ///< required
+  std::string policy_path;            ///< the policy's network file (or controller "pid")
   std::string controller = "policy";  ///< "policy" or "pid"
-  std::string vehicle_path;   ///< "": the mission's vehicle:, else default_vehicle_file()
-  std::string layout;         ///< "": inferred from the policy's input size
+  std::string vehicle_path;           ///< "": the mission's vehicle:, else default_vehicle_file()
+  std::string layout;                 ///< "": inferred from the policy's input size
   int vehicle_id = 0;
   int stale_steps = 3;
-  double speed = 1.0;         ///< the vehicle runs this many times faster than real time
+  double speed = 1.0;  ///< the vehicle runs this many times faster than real time
   /// Exit once the mission is complete (after holding its last way-point for linger_s) or
   /// aborted; otherwise hold until stopped, as on a vehicle.
   bool exit_when_finished = false;

@@ -38,8 +38,8 @@ void SafetySupervisor::enter(SupervisorState state, double time_s, const std::st
   if (state == state_ && reason == reason_) return;
   state_ = state;
   reason_ = reason;
-  events_.push_back({time_s, fmt::format("{}{}{}", to_string(state), reason.empty() ? "" : ": ",
-                                         reason)});
+  events_.push_back(
+      {time_s, fmt::format("{}{}{}", to_string(state), reason.empty() ? "" : ": ", reason)});
 }
 
 ThrustSource SafetySupervisor::abort_source() const {

@@ -3,9 +3,8 @@
 // above it is the same either way.
 #pragma once
 
-#include <auvrl_lcm/vehicle_state_t.hpp>
-
 #include <Eigen/Core>
+#include <auvrl_lcm/vehicle_state_t.hpp>
 #include <memory>
 #include <optional>
 #include <vector>

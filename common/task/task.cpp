@@ -279,7 +279,9 @@ StateLayout infer_layout(int input_dim, int num_thrusters) {
     sized.layout = layout;
     sized.num_thrusters = num_thrusters;
     if (input_dim == sized.state_dim()) return layout;
-    expected += (expected.empty() ? "" : layout == StateLayout::kExtendedThrust ? " or " : ", ") +
+    expected += (expected.empty()                         ? ""
+                 : layout == StateLayout::kExtendedThrust ? " or "
+                                                          : ", ") +
                 std::to_string(sized.state_dim()) + " (" + to_string(layout) + ")";
   }
   throw std::invalid_argument("a policy with " + std::to_string(input_dim) +

@@ -1,12 +1,12 @@
 // The deployable controller's safety supervisor in isolation: stale states, non-finite states
 // and outputs, limits, the end of a mission; what the thrusters get each step and what is
 // logged and counted.
-#include "agent/safety_supervisor.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+
+#include "agent/safety_supervisor.hpp"
 
 namespace auvrl::agent {
 namespace {

@@ -237,7 +237,8 @@ TEST(Controller, FilesThatDoNotFitAreRefusedAtStartNamingThem) {
   bytes[bytes.size() / 2] ^= 0x40;
   const std::string damaged = dir + "/damaged.nn";
   std::ofstream(damaged, std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
   refused({bin, "--mission", dir + "/mission.yaml", "--policy", damaged},
           "policy file " + damaged + ": not a usable network file");
   // A way-point with a negative reach radius.
@@ -281,7 +282,8 @@ TEST(Controller, ThePidFliesAMissionOnTheRealTimeSimulator) {
                            "--controller", "pid", "--speed", "10", "--exit-when-finished"},
                           dir + "/controller.log");
   const int status = controller.wait_for_exit(std::chrono::seconds(60));
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("[ figures  ] two way-points at x10 in %.1f s of wall-clock\n", wall_s);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << controller.log();
   EXPECT_NE(controller.log().find("way-point 1 of 2 done"), std::string::npos) << controller.log();

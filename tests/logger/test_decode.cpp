@@ -4,11 +4,11 @@
 // never a crash.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <auvrl_lcm/thruster_cmd_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
 #include <auvrl_logger_test/all_primitives_t.hpp>
 #include <auvrl_logger_test/nested_arrays_t.hpp>
-#include <algorithm>
 #include <map>
 #include <random>
 
@@ -199,8 +199,8 @@ TEST(Decode, AStringWithANulBeforeItsEndIsMalformed) {
   auvrl_lcm::vehicle_state_t state{};
   state.vehicle_name = "nessie7";
   std::vector<std::uint8_t> bytes = encode(state);
-  const auto at = std::search(bytes.begin(), bytes.end(), state.vehicle_name.begin(),
-                              state.vehicle_name.end());
+  const auto at =
+      std::search(bytes.begin(), bytes.end(), state.vehicle_name.begin(), state.vehicle_name.end());
   ASSERT_NE(at, bytes.end());
   DecodedMessage message;
   std::string error;
