@@ -10,7 +10,6 @@
 #include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
 #include "common/channels.hpp"
-#include "common/unrecoverable.hpp"
 
 namespace auvrl::agent {
 namespace {
@@ -35,6 +34,7 @@ ControllerNode::ControllerNode(const sim::VehicleModel& model, task::TaskConfig 
                                ControllerNodeOptions options, transport::Transport& transport,
                                std::ostream& log)
     : model_(model),
+      vehicle_(model.facts()),
       task_(std::move(task)),
       controller_(std::move(controller)),
       mission_(std::move(mission)),
@@ -44,7 +44,7 @@ ControllerNode::ControllerNode(const sim::VehicleModel& model, task::TaskConfig 
       supervisor_(options_.stale_steps, mission_.limits.surface_on_abort),
       states_(transport, channels::sim_state(options_.vehicle_id), 8),
       missions_(transport, channels::mission(options_.vehicle_id), 4) {
-  task::apply_vehicle(model_.facts(), task_);
+  task::apply_vehicle(vehicle_, task_);
   task_.validate();
   if (!(options_.speed > 0)) throw std::invalid_argument("--speed must be > 0");
   if (!controller_) throw std::invalid_argument("auv_controller needs a controller");
@@ -108,13 +108,8 @@ void ControllerNode::on_mission(const auvrl_lcm::mission_t& msg) {
 }
 
 void ControllerNode::check_vehicle(const auvrl_lcm::vehicle_state_t& msg) const {
-  const VehicleFacts ours = model_.facts();
-  const VehicleIdentity served{msg.vehicle_name, msg.num_thrusters,
-                               static_cast<std::uint32_t>(msg.vehicle_file_crc32)};
-  if (!same_vehicle(identity_of(ours), served)) {
-    throw UnrecoverableFault(vehicle_mismatch_message(
-        "auv_controller", ours, fmt::format("the vehicle on {}", states_.channel()), served));
-  }
+  expect_vehicle(vehicle_, msg, "auv_controller",
+                 fmt::format("the vehicle on {}", states_.channel()));
 }
 
 void ControllerNode::on_state(const auvrl_lcm::vehicle_state_t& msg) {

@@ -68,6 +68,7 @@ class ControllerNode {
   double mission_time_s() const;
 
   const sim::VehicleModel& model_;
+  const VehicleFacts vehicle_;  ///< model_.facts(), once: every state is checked against it
   task::TaskConfig task_;
   std::unique_ptr<Controller> controller_;
   Mission mission_;

@@ -19,6 +19,15 @@ VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& s) {
   return r;
 }
 
+void expect_vehicle(const VehicleFacts& expected, const auvrl_lcm::vehicle_state_t& msg,
+                    const std::string& who, const std::string& sender) {
+  const VehicleIdentity served{msg.vehicle_name, msg.num_thrusters,
+                               static_cast<std::uint32_t>(msg.vehicle_file_crc32)};
+  if (!same_vehicle(identity_of(expected), served)) {
+    throw UnrecoverableFault(vehicle_mismatch_message(who, expected, sender, served));
+  }
+}
+
 namespace {
 
 class InProcessLink final : public VehicleLink {
@@ -129,13 +138,8 @@ class LockstepLink final : public VehicleLink {
 
   /// The reply must come from the vehicle this actor expects.
   void check_vehicle(const auvrl_lcm::vehicle_state_t& reply) const {
-    const VehicleIdentity served{reply.vehicle_name, reply.num_thrusters,
-                                 static_cast<std::uint32_t>(reply.vehicle_file_crc32)};
-    if (!same_vehicle(identity_of(expected_), served)) {
-      throw UnrecoverableFault(vehicle_mismatch_message(
-          "this actor", expected_, "auv_sim (vehicle id " + std::to_string(vehicle_id_) + ")",
-          served));
-    }
+    expect_vehicle(expected_, reply, "this actor",
+                   "auv_sim (vehicle id " + std::to_string(vehicle_id_) + ")");
   }
 
   SimClient client_;

@@ -27,6 +27,11 @@ struct VehicleReport {
 /// What a vehicle_state_t message reports (the simulator's, or a real vehicle's driver's).
 VehicleReport vehicle_report(const auvrl_lcm::vehicle_state_t& msg);
 
+/// Throws UnrecoverableFault (naming `who` with `expected` and `sender` with what it names)
+/// unless the state names the expected vehicle: name, thruster count, file CRC-32.
+void expect_vehicle(const VehicleFacts& expected, const auvrl_lcm::vehicle_state_t& msg,
+                    const std::string& who, const std::string& sender);
+
 /// Initial conditions and faults of an episode.
 struct EpisodeStart {
   Eigen::Vector3d position_ned_m{0.0, 0.0, 5.0};

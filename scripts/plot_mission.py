@@ -28,6 +28,8 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
+
+    from plot_run import set_3d_limits  # noqa: E402  (beside this script: one 3-D framing)
 except ImportError as e:  # a clear note, not a traceback: auvrl run reports it
     print(f"plot_mission: cannot import {e.name}: apt install python3-matplotlib python3-numpy",
           file=sys.stderr)
@@ -63,24 +65,6 @@ def read_trajectory(path):
 def thruster_names(run, n):
     names = [r.get("name", "") for r in read_rows(os.path.join(run, "vehicle.csv"))]
     return names if len(names) == n and all(names) else [f"T{i + 1}" for i in range(n)]
-
-
-def set_3d_limits(ax, pts):
-    """Equal scale on the three axes around the points (east, north, depth)."""
-    pts = np.asarray(pts, dtype=float)
-    pts = pts[np.all(np.isfinite(pts), axis=1)]
-    if pts.size == 0:
-        return None
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
-    span = np.maximum(hi - lo, 1.0)
-    pad = 0.08 * span
-    lo, hi = lo - pad, hi + pad
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_zlim(hi[2], lo[2])  # depth increases downwards
-    box = np.maximum(hi - lo, 0.25 * (hi - lo).max())
-    ax.set_box_aspect(tuple(box))
-    return hi[2]
 
 
 def plot_3d(traj, waypoints, title, path):

@@ -402,11 +402,12 @@ def box_floor(pts):
 
 
 def set_3d_limits(ax, pts):
-    """Equal scale on the three axes around the points (east, north, depth)."""
+    """Equal scale on the three axes around the points (east, north, depth); returns the
+    deepest z of the box (None without finite points). plot_mission.py uses it too."""
     pts = np.asarray(pts, dtype=float)
     pts = pts[np.all(np.isfinite(pts), axis=1)]
     if pts.size == 0:
-        return
+        return None
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     span = np.maximum(hi - lo, 1.0)
     pad = 0.08 * span
@@ -416,6 +417,7 @@ def set_3d_limits(ax, pts):
     ax.set_zlim(hi[2], lo[2])  # depth increases downwards
     box = np.maximum(hi - lo, 0.25 * (hi - lo).max())
     ax.set_box_aspect(tuple(box))
+    return hi[2]
 
 
 def draw_3d(ax, traj, goal, color, label, reach_t, floor_z=None, arrow_m=0.8):
