@@ -32,23 +32,32 @@ namespace {
 
 class InProcessLink final : public VehicleLink {
  public:
-  explicit InProcessLink(const sim::VehicleModel& model) : model_(model) {}
-  int num_thrusters() const override { return model_.num_thrusters(); }
+  explicit InProcessLink(const sim::VehicleModel& model) : nominal_(model), model_(&model) {}
+  int num_thrusters() const override { return model_->num_thrusters(); }
 
   std::optional<VehicleReport> reset(const EpisodeStart& start) override {
+    if (start.model_variation.is_identity()) {
+      model_ = &nominal_;
+    } else {
+      varied_ = sim::vary_model(nominal_, start.model_variation);
+      model_ = &*varied_;
+    }
     sim::ResetSettings settings;
     settings.eta << start.position_ned_m, start.euler_rpy_rad;
     settings.nu << start.velocity_body_mps, start.angular_rate_body_rad_s;
     settings.thruster_efficiency =
         start.thruster_efficiency.empty()
-            ? sim::ThrusterVector::Ones(model_.num_thrusters())
+            ? sim::ThrusterVector::Ones(model_->num_thrusters())
             : sim::ThrusterVector(Eigen::Map<const Eigen::VectorXd>(
                   start.thruster_efficiency.data(),
                   static_cast<Eigen::Index>(start.thruster_efficiency.size())));
     settings.current.constant_velocity_ned_mps = start.current_ned_mps;
+    settings.current.gauss_markov_speed_sigma_mps = start.current_varying_sigma_mps;
+    settings.current.gauss_markov_time_constant_s = start.current_varying_time_constant_s;
+    settings.current.gauss_markov_direction_rad = start.current_varying_direction_rad;
     settings.sensor_noise = start.sensor_noise;
     settings.seed = start.seed;
-    state_ = sim::make_state(model_, settings);
+    state_ = sim::make_state(*model_, settings);
     return report();
   }
 
@@ -56,14 +65,14 @@ class InProcessLink final : public VehicleLink {
     if (!state_) return std::nullopt;
     command_ = Eigen::Map<const Eigen::VectorXd>(thrust_n.data(),
                                                  static_cast<Eigen::Index>(thrust_n.size()));
-    sim::step(model_, *state_, command_);
+    sim::step(*model_, *state_, command_);
     return report();
   }
 
   bool set_thruster_efficiency(const std::vector<double>& efficiency) override {
     if (!state_) return false;
     sim::set_thruster_efficiency(
-        model_, *state_,
+        *model_, *state_,
         Eigen::Map<const Eigen::VectorXd>(efficiency.data(),
                                           static_cast<Eigen::Index>(efficiency.size())));
     return true;
@@ -77,7 +86,7 @@ class InProcessLink final : public VehicleLink {
 
  private:
   VehicleReport report() {
-    const sim::Measurement m = sim::measure(model_, *state_);
+    const sim::Measurement m = sim::measure(*model_, *state_);
     VehicleReport r;
     r.observation.position_ned_m = m.eta.head<3>();
     r.observation.euler_rpy_rad = m.eta.tail<3>();
@@ -90,7 +99,9 @@ class InProcessLink final : public VehicleLink {
     return r;
   }
 
-  const sim::VehicleModel& model_;
+  const sim::VehicleModel& nominal_;
+  std::optional<sim::VehicleModel> varied_;  ///< this episode's vehicle, when it is varied
+  const sim::VehicleModel* model_;           ///< nominal_ or varied_
   std::optional<sim::VehicleState> state_;
   sim::ThrusterVector command_;
 };
@@ -120,6 +131,13 @@ class LockstepLink final : public VehicleLink {
     msg.noise_attitude_rad = start.sensor_noise.attitude_sigma_rad;
     msg.noise_velocity_mps = start.sensor_noise.linear_velocity_sigma_mps;
     msg.noise_angular_rate_rad_s = start.sensor_noise.angular_velocity_sigma_rad_s;
+    msg.current_gm_sigma_mps = start.current_varying_sigma_mps;
+    msg.current_gm_time_constant_s = start.current_varying_time_constant_s;
+    msg.current_gm_direction_rad = start.current_varying_direction_rad;
+    if (!start.model_variation.is_identity()) {
+      throw std::invalid_argument(
+          "the lockstep link cannot vary auv_sim's vehicle model (EpisodeStart::model_variation)");
+    }
     msg.seed = static_cast<std::int64_t>(start.seed);
     const std::optional<auvrl_lcm::vehicle_state_t> reply = client_.reset(msg);
     if (reply) check_vehicle(*reply);

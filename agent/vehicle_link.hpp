@@ -13,6 +13,7 @@
 #include "common/task/task.hpp"
 #include "common/transport.hpp"
 #include "sim/dynamics.hpp"
+#include "sim/model_variation.hpp"
 
 namespace auvrl::agent {
 
@@ -38,9 +39,16 @@ struct EpisodeStart {
   Eigen::Vector3d euler_rpy_rad = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_body_mps = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_rate_body_rad_s = Eigen::Vector3d::Zero();
-  std::vector<double> thruster_efficiency;  ///< empty: all healthy
-  Eigen::Vector3d current_ned_mps = Eigen::Vector3d::Zero();
-  sim::SensorNoise sensor_noise;  ///< on what the vehicle reports; all zero: exact
+  std::vector<double> thruster_efficiency;                    ///< empty: all healthy
+  Eigen::Vector3d current_ned_mps = Eigen::Vector3d::Zero();  ///< the constant part, NED
+  /// The varying part of the current: a first-order Gauss-Markov speed along a heading
+  /// (sim::CurrentSettings); sigma 0: none.
+  double current_varying_sigma_mps = 0.0;
+  double current_varying_time_constant_s = 60.0;
+  double current_varying_direction_rad = 0.0;  ///< from north
+  sim::SensorNoise sensor_noise;               ///< on what the vehicle reports; all zero: exact
+  /// How the vehicle in the water differs from its file (default: not at all).
+  sim::ModelVariation model_variation;
   std::uint64_t seed = 1;
 };
 

@@ -13,6 +13,10 @@ inline std::string sim_state(int vehicle_id) { return "SIM_STATE_" + std::to_str
 inline std::string sim_reset(int vehicle_id) { return "SIM_RESET_" + std::to_string(vehicle_id); }
 /// Live thruster faults for vehicle id (thruster_fault_t).
 inline std::string sim_fault(int vehicle_id) { return "SIM_FAULT_" + std::to_string(vehicle_id); }
+/// Live water current changes for vehicle id (water_current_t).
+inline std::string sim_current(int vehicle_id) {
+  return "SIM_CURRENT_" + std::to_string(vehicle_id);
+}
 /// auv_sim's heartbeat (sim_heartbeat_t).
 inline const std::string kSimHeartbeat = "SIM_HEARTBEAT";
 
@@ -39,6 +43,7 @@ inline const std::string kMissionStatus = "MISSION_STATUS";
 inline const std::string kSimCommandPattern = "SIM_CMD_[0-9]+";
 inline const std::string kSimResetPattern = "SIM_RESET_[0-9]+";
 inline const std::string kSimFaultPattern = "SIM_FAULT_[0-9]+";
+inline const std::string kSimCurrentPattern = "SIM_CURRENT_[0-9]+";
 
 /// How a transport that distinguishes kinds of traffic (Cyclone DDS; LCM treats every channel
 /// alike) must carry a channel. Which class a channel belongs to is decided here, by the
@@ -50,7 +55,8 @@ enum class ChannelClass {
   /// Every message matters (experience, episode reports, weights requests): reliable with a
   /// bounded history, so a slow reader makes the writer wait (back-pressure) instead of losing.
   kQueue,
-  /// The simulator's lockstep loop (commands, states, resets, faults): latency first; the sim
+  /// The simulator's lockstep loop (commands, states, resets, faults, currents): latency first; the
+  /// sim
   /// client asks again by sequence number if an answer is missing.
   kLockstep,
   /// Everything else (heartbeats, statistics): reliable, a small keep-last history.
@@ -72,7 +78,8 @@ inline constexpr ChannelClassPrefix kChannelClassPrefixes[] = {
     {"SIM_CMD_", ChannelClass::kLockstep},      //
     {"SIM_STATE_", ChannelClass::kLockstep},    //
     {"SIM_RESET_", ChannelClass::kLockstep},    //
-    {"SIM_FAULT_", ChannelClass::kLockstep},
+    {"SIM_FAULT_", ChannelClass::kLockstep},    //
+    {"SIM_CURRENT_", ChannelClass::kLockstep},
 };
 
 /// The class of a channel (see kChannelClassPrefixes).

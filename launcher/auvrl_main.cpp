@@ -1,7 +1,8 @@
 // auvrl: the project's front command. Each subcommand parses its own options and calls the
 // library that does the work (eval/evaluation.hpp for eval, tools/arrival_search.hpp for fastest,
 // tuning/pid_tuning.hpp for tune-pid, tools/export/policy_export.hpp for export,
-// launcher/mission_run.hpp for run); adding one is adding a row to kSubcommands.
+// launcher/mission_run.hpp for run, launcher/mission_replay.hpp for replay); adding one is adding
+// a row to kSubcommands.
 #include <exception>
 #include <filesystem>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "eval/mission_run.hpp"
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
+#include "launcher/mission_replay.hpp"
 #include "launcher/mission_run.hpp"
 #include "tools/arrival_search.hpp"
 #include "tools/export/policy_export.hpp"
@@ -247,6 +249,35 @@ int run_mission_command(int argc, const char* const* argv) {
   return auvrl::launcher::start_mission_run(options, network == "host", std::cout);
 }
 
+/// `auvrl replay`: a mission run's log played back by lcm-logplayer and recorded again.
+int run_replay_command(int argc, const char* const* argv) {
+  auvrl::launcher::MissionReplayOptions options;
+  options.source_dir = AUVRL_SOURCE_DIR;
+  options.bin_dir = own_bin_dir();
+  std::string network = "private";
+  auvrl::cli::CommandLine cli(
+      "auvrl replay",
+      "Plays an `auvrl run` directory's LCM log back with lcm-logplayer in a private network\n"
+      "namespace, records it as auvrl run does live, and writes OUT/trajectory.csv,\n"
+      "waypoints.csv, vehicle.csv, events.csv, plots/ and report.md, each CSV compared with the\n"
+      "run's. Exit: 0 written, 1 error, 2 refused at start, 130 stopped.");
+  cli.option("run-dir", &options.run_dir, "the auvrl run directory to replay");
+  cli.require("run-dir");
+  cli.option("out", &options.out_dir, "output directory (default RUN/replay-<time>)");
+  cli.option("speed", &options.speed, "playback speed multiplier (lcm-logplayer --speed)");
+  cli.option("mission", &options.mission_path, "the run's mission (default RUN/mission.yaml)");
+  cli.option("vehicle", &options.vehicle_path, "the run's vehicle (default RUN/vehicle.yaml)");
+  cli.option("player", &options.player, "the log player");
+  cli.option("network", &network,
+             "private (default: own network namespace) or host (LCM on the host's network)");
+  cli.choices("network", {"private", "host"});
+  // Set by auvrl replay itself when it runs again inside the network namespace.
+  cli.flag("prepared", &options.prepared, "the output directory is prepared already (internal)");
+  cli.app().get_option("--prepared")->group("");
+  if (!cli.parse(argc, argv)) return 0;
+  return auvrl::launcher::start_mission_replay(options, network == "host", std::cout);
+}
+
 /// `auvrl config-doc`: prints docs/configuration.md.
 int run_config_doc(int argc, const char* const* argv) {
   auvrl::cli::CommandLine cli("auvrl config-doc",
@@ -267,6 +298,8 @@ const Subcommand kSubcommands[] = {
     {"train", "train a policy with the whole system, then evaluate it (see --help)", run_train},
     {"run", "fly a mission with auv_controller on the real-time simulator (see --help)",
      run_mission_command},
+    {"replay", "play a mission run's log back and write its files and plots again (see --help)",
+     run_replay_command},
     {"eval",
      "evaluate a policy or the PID baseline on test1/test2/fault/current/suite or a mission",
      run_eval},

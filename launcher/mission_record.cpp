@@ -20,7 +20,78 @@ task::Observation observation_of(const auvrl_lcm::vehicle_state_t& msg) {
   return o;
 }
 
+/// Efficiencies and currents are copied, not computed: equal means the same double within the
+/// rounding of text.
+constexpr double kCopiedValueTolerance = 1e-9;
+
 }  // namespace
+
+MissionEventLog::MissionEventLog(const agent::Mission& mission,
+                                 std::vector<std::string> thruster_names)
+    : thruster_names_(std::move(thruster_names)), efficiency_(thruster_names_.size(), 1.0) {
+  for (const agent::MissionEvent& e : mission.events) {
+    if (e.kind == agent::MissionEvent::Kind::kCurrent && e.time_s == 0.0) {
+      const Eigen::Vector3d& c = e.current_ned_mps;
+      start_current_ned_mps_ = c;
+      events_.push_back(
+          {0.0, fmt::format("t=0 s: water current [{:g}, {:g}, {:g}] m/s NED, set with the "
+                            "vehicle's reset",
+                            c.x(), c.y(), c.z())});
+      continue;
+    }
+    live_.push_back(e);
+  }
+  live_seen_.assign(live_.size(), false);
+}
+
+std::string MissionEventLog::take_due(
+    const std::function<bool(const agent::MissionEvent&)>& matches) {
+  for (std::size_t k = 0; k < live_.size(); ++k) {
+    if (live_seen_[k] || !matches(live_[k])) continue;
+    live_seen_[k] = true;
+    return fmt::format("due at {:g} s", live_[k].time_s);
+  }
+  return "not one of the mission's events";
+}
+
+MissionRunEvent MissionEventLog::add_current(const auvrl_lcm::water_current_t& current,
+                                             std::optional<double> mission_time_s,
+                                             const std::string& channel) {
+  const double t = mission_time_s.value_or(0.0);
+  const Eigen::Vector3d c(current.current_constant_ned_mps[0], current.current_constant_ned_mps[1],
+                          current.current_constant_ned_mps[2]);
+  const std::string due = take_due([&](const agent::MissionEvent& e) {
+    return e.kind == agent::MissionEvent::Kind::kCurrent &&
+           (e.current_ned_mps - c).cwiseAbs().maxCoeff() <= kCopiedValueTolerance;
+  });
+  events_.push_back({t, fmt::format("t={:.1f} s ({}): water current [{:g}, {:g}, {:g}] m/s NED, "
+                                    "injected on {}",
+                                    t, due, c.x(), c.y(), c.z(), channel)});
+  return events_.back();
+}
+
+std::vector<MissionRunEvent> MissionEventLog::add_fault(const auvrl_lcm::thruster_fault_t& fault,
+                                                        std::optional<double> mission_time_s,
+                                                        const std::string& channel) {
+  std::vector<MissionRunEvent> added;
+  if (fault.thruster_efficiency.size() != efficiency_.size()) return added;
+  const double t = mission_time_s.value_or(0.0);
+  for (std::size_t i = 0; i < efficiency_.size(); ++i) {
+    const double efficiency = fault.thruster_efficiency[i];
+    if (std::abs(efficiency - efficiency_[i]) <= kCopiedValueTolerance) continue;
+    efficiency_[i] = efficiency;
+    const std::string due = take_due([&](const agent::MissionEvent& e) {
+      return e.kind == agent::MissionEvent::Kind::kThrusterEfficiency &&
+             e.thruster == static_cast<int>(i) &&
+             std::abs(e.efficiency - efficiency) <= kCopiedValueTolerance;
+    });
+    added.push_back({t, fmt::format("t={:.1f} s ({}): thruster {} ({}) at {:g} % efficiency, "
+                                    "injected on {}",
+                                    t, due, i, thruster_names_[i], 100.0 * efficiency, channel)});
+  }
+  events_.insert(events_.end(), added.begin(), added.end());
+  return added;
+}
 
 MissionRecorder::MissionRecorder(int num_thrusters)
     : num_thrusters_(num_thrusters), command_n_(static_cast<std::size_t>(num_thrusters), 0.0) {}

@@ -1,14 +1,19 @@
-// What `auvrl run` records while a mission runs (every SIM_STATE_<id>, SIM_CMD_<id> and
-// MISSION_STATUS) and what it makes of it afterwards: the trajectory from the controller's
-// first state on, and one row per way-point computed by feeding a MissionTracker (the one
-// auv_controller uses) with the recorded states, in the in-process evaluation's form
-// (eval/mission_run.hpp: waypoints.csv is its mission.csv). No processes and no transport here:
-// tests feed messages directly.
+// What `auvrl run` records while a mission runs (every SIM_STATE_<id>, SIM_CMD_<id>,
+// SIM_FAULT_<id> and MISSION_STATUS) and what it makes of it afterwards: the trajectory from
+// the controller's first state on, the events as applied, and one row per way-point computed by
+// feeding a MissionTracker (the one auv_controller uses) with the recorded states, in the
+// in-process evaluation's form (eval/mission_run.hpp: waypoints.csv is its mission.csv). Only
+// messages count, in the order they arrive, so `auvrl replay` (the run's log played back by
+// lcm-logplayer) records the same. No processes and no transport here: tests feed messages
+// directly.
 #pragma once
 
 #include <auvrl_lcm/mission_status_t.hpp>
 #include <auvrl_lcm/thruster_cmd_t.hpp>
+#include <auvrl_lcm/thruster_fault_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
+#include <auvrl_lcm/water_current_t.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +23,52 @@
 #include "eval/mission_run.hpp"
 
 namespace auvrl::launcher {
+
+/// An event of the mission as the run applied it.
+struct MissionRunEvent {
+  double time_s = 0;  ///< mission time when it was applied, s
+  std::string text;   ///< what, with its time ("t=20.0 s (due at 20 s): thruster 0 (T1) at ...")
+};
+
+/// The mission's events as the vehicle got them. A current at time 0 is the water's current
+/// from the start (set with the vehicle's reset). Every later change is a message heard on the
+/// bus (what `auvrl run` injects, heard back, or its replay), at the mission time of the newest
+/// state before it, with the due time of the mission's event it applies: a water current on
+/// SIM_CURRENT_<id> is one event, a fault on SIM_FAULT_<id> one per thruster whose efficiency
+/// it changes.
+class MissionEventLog {
+ public:
+  /// thruster_names: the vehicle's, one per thruster.
+  MissionEventLog(const agent::Mission& mission, std::vector<std::string> thruster_names);
+
+  /// A fault message heard on `channel` when the mission time was mission_time_s (nothing
+  /// before the mission start: 0). Returns the events it adds (a message that changes nothing,
+  /// or names another number of thrusters, adds none).
+  std::vector<MissionRunEvent> add_fault(const auvrl_lcm::thruster_fault_t& fault,
+                                         std::optional<double> mission_time_s,
+                                         const std::string& channel);
+
+  /// A current message heard on `channel` at mission_time_s (as add_fault). Returns its event.
+  MissionRunEvent add_current(const auvrl_lcm::water_current_t& current,
+                              std::optional<double> mission_time_s, const std::string& channel);
+
+  /// The events applied so far, in order (the current from the start first).
+  const std::vector<MissionRunEvent>& events() const { return events_; }
+  /// The water current the vehicle starts in (NED, m/s): the mission's current at time 0.
+  const Eigen::Vector3d& start_current_ned_mps() const { return start_current_ned_mps_; }
+
+ private:
+  /// The mission's events after the start, in order, and whether a message matched each yet.
+  std::vector<agent::MissionEvent> live_;
+  std::vector<bool> live_seen_;
+  /// "due at T s" of the first unmatched event of live_ that `matches`, now matched; or "not
+  /// one of the mission's events".
+  std::string take_due(const std::function<bool(const agent::MissionEvent&)>& matches);
+  std::vector<std::string> thruster_names_;
+  std::vector<double> efficiency_;  ///< per thruster, as the last message left it
+  std::vector<MissionRunEvent> events_;
+  Eigen::Vector3d start_current_ned_mps_ = Eigen::Vector3d::Zero();
+};
 
 /// The record of one vehicle's traffic during a mission.
 class MissionRecorder {

@@ -11,6 +11,7 @@
 #include "agent/safety_supervisor.hpp"
 #include "common/csv.hpp"
 #include "common/process.hpp"
+#include "eval/evaluation.hpp"
 
 namespace auvrl::launcher {
 
@@ -62,16 +63,12 @@ void write_supervisor(std::ostream& md, const MissionRunSummary& s) {
 
 void write_events(std::ostream& md, const MissionRunSummary& s) {
   md << "## Events\n\n";
-  if (s.events.empty() && s.not_applied.empty()) md << "The mission has no events.\n";
+  if (s.events.empty()) md << "The mission has no events.\n";
   for (const MissionRunEvent& e : s.events) md << "- " << e.text << "\n";
-  if (!s.not_applied.empty()) {
-    md << "\nNot applied: auv_sim cannot change the water current of a running vehicle (it takes "
-          "a current only with a reset, which would also move the vehicle):\n\n";
-    for (const std::string& e : s.not_applied) md << "- " << e << "\n";
-  }
-  if (s.sim_faults_total) {
-    md << "\nauv_sim applied " << *s.sim_faults_total
-       << " live thruster fault(s) (faults_total of its last heartbeat).\n";
+  if (s.sim_faults_total && s.sim_currents_total) {
+    md << "\nauv_sim applied " << *s.sim_faults_total << " live thruster fault(s) and "
+       << *s.sim_currents_total
+       << " live current change(s) (faults_total and currents_total of its last heartbeat).\n";
   }
   md << "\n";
 }
@@ -92,9 +89,28 @@ double achieved_realtime_factor(const MissionRunSummary& s) {
   return s.mission_wall_s > 0 ? s.vehicle_time_s / s.mission_wall_s : 0.0;
 }
 
-std::string draw_mission_plots(const MissionRunOptions& o) {
+std::vector<eval::MissionWaypointRow> write_mission_record(const std::string& dir,
+                                                           const agent::Mission& mission,
+                                                           const VehicleFacts& facts,
+                                                           const MissionRecorder& recorder,
+                                                           const MissionEventLog& events) {
+  std::vector<agent::TrajectoryRow> rows = recorder.trajectory();
+  const MissionAnalysis analysis = analyse_waypoints(mission.waypoints, rows, facts.max_thrust_n);
+  const fs::path d = dir;
+  eval::write_trajectory_csv((d / "trajectory.csv").string(), rows, facts.num_thrusters(),
+                             &analysis.waypoint_index);
+  eval::write_vehicle_csv((d / "vehicle.csv").string(), facts);
+  eval::MissionOutcome outcome;  // write_mission_csv writes its way-points only
+  outcome.waypoints = analysis.waypoints;
+  eval::write_mission_csv((d / "waypoints.csv").string(), outcome);
+  write_events_csv((d / "events.csv").string(), events.events());
+  return analysis.waypoints;
+}
+
+std::string draw_mission_plots(const std::string& source_dir, const std::string& dir,
+                               const std::string& run_name) {
   const std::string python = "/usr/bin/python3";
-  const std::string script = o.source_dir + "/scripts/plot_mission.py";
+  const std::string script = source_dir + "/scripts/plot_mission.py";
   if (!fs::exists(python)) {
     return fmt::format(
         "No plots: {} is not installed (apt install python3 python3-matplotlib "
@@ -102,8 +118,9 @@ std::string draw_mission_plots(const MissionRunOptions& o) {
         python);
   }
   if (!fs::exists(script)) return "No plots: " + script + " not found.";
-  const std::string log = (fs::path(o.run_dir) / "processes" / "plots.log").string();
-  process::ChildProcess plotter({python, script, o.run_dir}, log);
+  fs::create_directories(fs::path(dir) / "processes");
+  const std::string log = (fs::path(dir) / "processes" / "plots.log").string();
+  process::ChildProcess plotter({python, script, dir, run_name}, log);
   const int status = plotter.wait_for_exit(std::chrono::minutes(2));
   if (status == -1) {
     plotter.terminate();

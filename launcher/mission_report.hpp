@@ -1,5 +1,5 @@
-// The end of `auvrl run`: the plots (scripts/plot_mission.py) and RUN/report.md, from what the
-// run recorded.
+// The end of `auvrl run` and `auvrl replay`: the CSV files, the plots (scripts/plot_mission.py)
+// and the report, from what the run recorded.
 #pragma once
 
 #include <auvrl_lcm/mission_status_t.hpp>
@@ -10,16 +10,11 @@
 #include <vector>
 
 #include "agent/mission.hpp"
+#include "common/vehicle_facts.hpp"
 #include "launcher/mission_record.hpp"
 #include "launcher/mission_run.hpp"
 
 namespace auvrl::launcher {
-
-/// An event of the mission as the run applied it.
-struct MissionRunEvent {
-  double time_s = 0;  ///< mission time when it was applied, s
-  std::string text;   ///< what, with its time ("t=20.0 s (due at 20 s): thruster 0 (T1) at ...")
-};
 
 /// What a mission run did, for its report.
 struct MissionRunSummary {
@@ -31,9 +26,9 @@ struct MissionRunSummary {
   double vehicle_time_s = 0;  ///< the vehicle clock over the same states, s
   std::optional<auvrl_lcm::mission_status_t> last_status;  ///< the last MISSION_STATUS
   std::vector<MissionRunEvent> events;                     ///< the events applied, in order
-  std::vector<std::string> not_applied;  ///< events that could not be applied, and why
-  /// auv_sim's faults_total from its last heartbeat (live faults it applied); none if unheard.
-  std::optional<std::int64_t> sim_faults_total;
+  /// auv_sim's faults_total and currents_total from its last heartbeat (the live faults and
+  /// current changes it applied); none if unheard.
+  std::optional<std::int64_t> sim_faults_total, sim_currents_total;
   std::vector<eval::MissionWaypointRow> waypoints;
   std::string plots_note;  ///< empty when the plots were drawn; otherwise why not
 };
@@ -41,10 +36,22 @@ struct MissionRunSummary {
 /// The real-time factor achieved: vehicle time / wall time (0 when no wall time passed).
 double achieved_realtime_factor(const MissionRunSummary& summary);
 
-/// Runs scripts/plot_mission.py on the run directory (RUN/plots/mission_3d.png and
-/// mission_thrusters.png); returns "" when it drew them, else a note saying why not (Python or
-/// matplotlib missing: the note says what to install; a failure: where its output is).
-std::string draw_mission_plots(const MissionRunOptions& options);
+/// Writes what a mission's record gives into dir: trajectory.csv (every state from the mission
+/// start, with the way-point driven to), vehicle.csv, waypoints.csv (one row per way-point) and
+/// events.csv; returns the per-way-point rows. The same record, live or replayed, gives the
+/// same bytes. Throws std::runtime_error naming a file that cannot be written.
+std::vector<eval::MissionWaypointRow> write_mission_record(const std::string& dir,
+                                                           const agent::Mission& mission,
+                                                           const VehicleFacts& facts,
+                                                           const MissionRecorder& recorder,
+                                                           const MissionEventLog& events);
+
+/// Runs SOURCE/scripts/plot_mission.py on dir (dir/plots/mission_3d.png and
+/// mission_thrusters.png, titled with run_name; its output goes to dir/processes/plots.log);
+/// returns "" when it drew them, else a note saying why not (Python or matplotlib missing: the
+/// note says what to install; a failure: where its output is).
+std::string draw_mission_plots(const std::string& source_dir, const std::string& dir,
+                               const std::string& run_name);
 
 /// The auv_controller lines of its log (processes/controller.log): its start, every event and
 /// way-point with its vehicle time, its end.

@@ -11,6 +11,7 @@
 #include <auvrl_lcm/thruster_fault_t.hpp>
 #include <auvrl_lcm/vehicle_reset_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
+#include <auvrl_lcm/water_current_t.hpp>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -114,6 +115,7 @@ void write_mission_readme(const MissionRunOptions& o) {
   std::ofstream out(fs::path(o.run_dir) / "README.txt");
   out << "auvrl run directory (a mission flown by auv_controller on auv_sim --realtime)\n"
       << "  mission.yaml      a copy of " << o.mission_path << "\n"
+      << "  vehicle.yaml      a copy of " << o.vehicle_path << "\n"
       << "  trajectory.csv    every state from the mission start, with the command in force and\n"
       << "                    the way-point driven to (auvrl eval --mission's trajectory format)\n"
       << "  waypoints.csv     one row per way-point, index from 0: reached, time to reach, hold\n"
@@ -123,7 +125,8 @@ void write_mission_readme(const MissionRunOptions& o) {
       << "  report.md         the table, times, real-time factor, supervisor, events, plots\n"
       << "  plots/            mission_3d.png, mission_thrusters.png\n"
       << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
-      << "  processes/        each process's output (logger, sim, controller, plots)\n";
+      << "  processes/        each process's output (logger, sim, controller, plots)\n"
+      << "  replay-*/         what `auvrl replay --run-dir` made of logs/, compared with the run\n";
   if (!out) throw std::runtime_error("cannot write " + o.run_dir + "/README.txt");
 }
 
@@ -139,6 +142,7 @@ void prepare_mission_run(MissionRunOptions& o) {
   }
   for (const char* sub : {"logs", "processes", "plots"}) fs::create_directories(dir / sub);
   fs::copy_file(o.mission_path, dir / "mission.yaml");
+  fs::copy_file(o.vehicle_path, dir / "vehicle.yaml");  // what `auvrl replay` reads the log with
   write_mission_readme(o);
 }
 
@@ -198,7 +202,6 @@ class MissionSession {
   void wait_for(const std::function<bool()>& done, const std::string& name, Process& process);
   void start_processes();
   void place_vehicle();
-  void note_current_events();
   std::optional<MissionEnd> watch();
   MissionEnd controller_ended();
   void inject_due_events();
@@ -219,12 +222,10 @@ class MissionSession {
   MissionRecorder recorder_;
   std::int64_t states_seen_ = 0;
   bool logger_heard_ = false;
-  std::optional<std::int64_t> sim_faults_total_;
-  Eigen::Vector3d reset_current_ned_mps_ = Eigen::Vector3d::Zero();
-  std::vector<double> efficiency_;
+  std::optional<std::int64_t> sim_faults_total_, sim_currents_total_;
+  std::vector<double> efficiency_;  ///< what the faults injected so far left, per thruster
   std::size_t next_event_ = 0;
-  std::vector<MissionRunEvent> events_;
-  std::vector<std::string> not_applied_;
+  MissionEventLog event_log_;
   double next_progress_s_ = 0;
   // Last, so that it goes first: its handlers use the members above.
   std::unique_ptr<transport::Transport> transport_;
@@ -238,7 +239,8 @@ MissionSession::MissionSession(const MissionRunOptions& options, std::ostream& o
       model_(sim::load_vehicle_file(options.vehicle_path)),
       start_s_(clock_.now_s()),
       recorder_(model_.num_thrusters()),
-      efficiency_(static_cast<std::size_t>(model_.num_thrusters()), 1.0) {}
+      efficiency_(static_cast<std::size_t>(model_.num_thrusters()), 1.0),
+      event_log_(mission_, model_.facts().thruster_names) {}
 
 void MissionSession::subscribe() {
   transport_ = transport::make_transport({});
@@ -256,10 +258,28 @@ void MissionSession::subscribe() {
       [this](const std::string&, const auvrl_lcm::mission_status_t& s) {
         if (s.vehicle_id == kVehicleId) recorder_.add_status(s);
       });
+  // The faults as they reach the vehicle's channel (those this command injects, heard back):
+  // events.csv is built from them, as `auvrl replay` builds it from the log.
+  transport::subscribe<auvrl_lcm::thruster_fault_t>(
+      *transport_, channels::sim_fault(kVehicleId),
+      [this](const std::string& channel, const auvrl_lcm::thruster_fault_t& f) {
+        for (const MissionRunEvent& e :
+             event_log_.add_fault(f, recorder_.mission_time_s(), channel)) {
+          out_ << (tty_ ? "\n" : "") << "auvrl run: " << e.text << "\n";
+        }
+      });
+  transport::subscribe<auvrl_lcm::water_current_t>(
+      *transport_, channels::sim_current(kVehicleId),
+      [this](const std::string& channel, const auvrl_lcm::water_current_t& c) {
+        const MissionRunEvent e = event_log_.add_current(c, recorder_.mission_time_s(), channel);
+        out_ << (tty_ ? "\n" : "") << "auvrl run: " << e.text << "\n";
+      });
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *transport_, channels::kSimHeartbeat,
       [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
-        if (sim_ && h.pid == sim_->pid()) sim_faults_total_ = h.faults_total;
+        if (!sim_ || h.pid != sim_->pid()) return;
+        sim_faults_total_ = h.faults_total;
+        sim_currents_total_ = h.currents_total;
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
       *transport_, channels::kLoggerHeartbeat,
@@ -326,7 +346,7 @@ void MissionSession::place_vehicle() {
   for (int i = 0; i < 3; ++i) {
     reset.position_ned_m[i] = mission_.start.position_ned_m[i];
     reset.euler_rpy_rad[i] = mission_.start.euler_rpy_rad[i];
-    reset.current_constant_ned_mps[i] = reset_current_ned_mps_[i];
+    reset.current_constant_ned_mps[i] = event_log_.start_current_ned_mps()[i];
   }
   reset.num_thrusters = 0;  // all healthy
   reset.noise_position_m = mission_.sensor_noise.position_m;
@@ -348,32 +368,6 @@ void MissionSession::place_vehicle() {
       "sim", *sim_);
 }
 
-/// Current changes: one at time 0 is the water's current from the start, set with the reset;
-/// auv_sim has no live current message, so any later one is not applied (said once, here).
-void MissionSession::note_current_events() {
-  for (const agent::MissionEvent& e : mission_.events) {
-    if (e.kind != agent::MissionEvent::Kind::kCurrent) continue;
-    const Eigen::Vector3d& c = e.current_ned_mps;
-    if (e.time_s == 0.0) {
-      reset_current_ned_mps_ = c;
-      events_.push_back(
-          {0.0, fmt::format("t=0 s: water current [{:g}, {:g}, {:g}] m/s NED, set with the "
-                            "vehicle's reset",
-                            c.x(), c.y(), c.z())});
-      continue;
-    }
-    not_applied_.push_back(
-        fmt::format("t={:g} s: water current [{:g}, {:g}, {:g}] m/s NED: not applied", e.time_s,
-                    c.x(), c.y(), c.z()));
-  }
-  if (not_applied_.empty()) return;
-  out_ << "auvrl run: note: auv_sim cannot change the water current of a running vehicle (it "
-          "takes a current only with a reset, which would also move the vehicle), so the "
-          "mission's "
-       << not_applied_.size() << " later current change(s) are not applied:\n";
-  for (const std::string& line : not_applied_) out_ << "  " << line << "\n";
-}
-
 void MissionSession::inject_due_events() {
   const std::optional<double> t = recorder_.mission_time_s();
   if (!t) return;
@@ -381,7 +375,15 @@ void MissionSession::inject_due_events() {
   for (; next_event_ < events.size() && events[next_event_].time_s <= *t + kTimeToleranceS;
        ++next_event_) {
     const agent::MissionEvent& e = events[next_event_];
-    if (e.kind != agent::MissionEvent::Kind::kThrusterEfficiency) continue;
+    if (e.kind == agent::MissionEvent::Kind::kCurrent) {
+      if (e.time_s == 0.0) continue;  // set with the vehicle's reset
+      auvrl_lcm::water_current_t current{};
+      current.utime = transport::now_utime();
+      current.vehicle_id = kVehicleId;
+      for (int i = 0; i < 3; ++i) current.current_constant_ned_mps[i] = e.current_ned_mps[i];
+      transport::publish(*transport_, channels::sim_current(kVehicleId), current);
+      continue;
+    }
     efficiency_[static_cast<std::size_t>(e.thruster)] = e.efficiency;
     auvrl_lcm::thruster_fault_t fault{};
     fault.utime = transport::now_utime();
@@ -389,15 +391,6 @@ void MissionSession::inject_due_events() {
     fault.num_thrusters = static_cast<std::int8_t>(efficiency_.size());
     fault.thruster_efficiency = efficiency_;
     transport::publish(*transport_, channels::sim_fault(kVehicleId), fault);
-    const VehicleFacts facts = model_.facts();
-    const std::string& name = facts.thruster_names[static_cast<std::size_t>(e.thruster)];
-    events_.push_back(
-        {*t,
-         fmt::format(
-             "t={:.1f} s (due at {:g} s): thruster {} ({}) at {:g} % efficiency, injected on {}",
-             *t, e.time_s, e.thruster, name, 100.0 * e.efficiency,
-             channels::sim_fault(kVehicleId))});
-    out_ << (tty_ ? "\n" : "") << "auvrl run: " << events_.back().text << "\n";
   }
 }
 
@@ -490,25 +483,17 @@ int MissionSession::finish(const MissionEnd& end) {
   s.ended = end.reason;
   s.wall_s = clock_.now_s() - start_s_;
   s.mission_wall_s = recorder_.mission_wall_s();
-  std::vector<agent::TrajectoryRow> rows = recorder_.trajectory();
+  const std::vector<agent::TrajectoryRow> rows = recorder_.trajectory();
   s.vehicle_time_s = rows.empty() ? 0.0 : rows.back().time_s;
   s.last_status = recorder_.last_status();
-  s.events = events_;
-  s.not_applied = not_applied_;
+  s.events = event_log_.events();
   s.sim_faults_total = sim_faults_total_;
-  const VehicleFacts facts = model_.facts();
-  const MissionAnalysis analysis = analyse_waypoints(mission_.waypoints, rows, facts.max_thrust_n);
-  s.waypoints = analysis.waypoints;
-  const fs::path dir = options_.run_dir;
+  s.sim_currents_total = sim_currents_total_;
   try {
-    eval::write_trajectory_csv((dir / "trajectory.csv").string(), rows, facts.num_thrusters(),
-                               &analysis.waypoint_index);
-    eval::write_vehicle_csv((dir / "vehicle.csv").string(), facts);
-    eval::MissionOutcome outcome;  // write_mission_csv writes its way-points only
-    outcome.waypoints = s.waypoints;
-    eval::write_mission_csv((dir / "waypoints.csv").string(), outcome);
-    write_events_csv((dir / "events.csv").string(), s.events);
-    s.plots_note = draw_mission_plots(options_);
+    s.waypoints =
+        write_mission_record(options_.run_dir, mission_, model_.facts(), recorder_, event_log_);
+    s.plots_note = draw_mission_plots(options_.source_dir, options_.run_dir,
+                                      fs::path(options_.run_dir).filename().string());
     write_mission_report(options_, mission_, s);
   } catch (const std::exception& e) {
     out_ << "auvrl run: " << e.what() << "\n";
@@ -521,7 +506,6 @@ int MissionSession::finish(const MissionEnd& end) {
 int MissionSession::run() {
   signals::install_stop_handlers();
   subscribe();
-  note_current_events();
   std::optional<MissionEnd> end;
   try {
     start_processes();

@@ -2,10 +2,11 @@
 // command, the way it would fly on a vehicle. In a run directory it starts auv_logger, auv_sim
 // --realtime, places the vehicle at the mission's start (vehicle_reset_t), then starts
 // auv_controller; it shows the mission's progress (MISSION_STATUS), records every state and
-// command, injects the mission's timed thruster faults live (thruster_fault_t on SIM_FAULT_0),
-// and stops when the controller exits, the mission's time limit passes or on Ctrl-C. Then it
-// writes trajectory.csv, vehicle.csv, waypoints.csv, events.csv, the plots and report.md
-// (docs/deployment.md, "auvrl run").
+// command, injects the mission's timed thruster faults and current changes live
+// (thruster_fault_t on SIM_FAULT_0, water_current_t on SIM_CURRENT_0), and stops when the
+// controller exits, the mission's time limit passes or on Ctrl-C. Then it writes trajectory.csv,
+// vehicle.csv, waypoints.csv, events.csv, the plots and report.md (docs/deployment.md, "auvrl
+// run").
 #pragma once
 
 #include <ostream>

@@ -1,7 +1,10 @@
 #!/usr/bin/python3
 """Plots of an `auvrl run` mission directory.
 
-Usage: /usr/bin/python3 scripts/plot_mission.py RUN
+Usage: /usr/bin/python3 scripts/plot_mission.py RUN [NAME]
+
+NAME heads the titles (default: RUN's own name); `auvrl replay` gives the replayed run's, so that
+the replay's plots are the run's.
 
 Reads what `auvrl run` writes into RUN:
   trajectory.csv   t, x, y, z, phi, theta, psi, ..., cmd_1..cmd_n, thrust_1..thrust_n, distance_m
@@ -139,10 +142,11 @@ def plot_thrusters(traj, names, waypoints, events, title, path):
 
 
 def main(argv):
-    if len(argv) != 2:
+    if len(argv) not in (2, 3):
         print(__doc__, file=sys.stderr)
         return 2
     run = argv[1]
+    name = argv[2] if len(argv) == 3 else os.path.basename(os.path.normpath(run))
     traj = read_trajectory(os.path.join(run, "trajectory.csv")) if os.path.isdir(run) else None
     if traj is None or "t" not in traj or len(traj["t"]) == 0:
         print(f"plot_mission: {run}/trajectory.csv is missing or holds no row", file=sys.stderr)
@@ -154,7 +158,7 @@ def main(argv):
     nthr = sum(1 for k in traj if k.startswith("thrust_"))
     names = thruster_names(run, nthr)
     reached = sum(1 for w in waypoints if w.get("reached") == "1")
-    title = (f"{os.path.basename(os.path.normpath(run))}: {reached} of {len(waypoints)} "
+    title = (f"{name}: {reached} of {len(waypoints)} "
              f"way-points reached in {traj['t'][-1]:.1f} s")
     plots = os.path.join(run, "plots")
     try:

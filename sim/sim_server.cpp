@@ -138,6 +138,10 @@ SimServer::SimServer(const VehicleModel& model, transport::Transport& transport,
       transport_, channels::kSimFaultPattern,
       [this](const std::string& ch, const auvrl_lcm::thruster_fault_t& m) { on_fault(ch, m); },
       &decode_stats_));
+  subscriptions_.push_back(subscribe<auvrl_lcm::water_current_t>(
+      transport_, channels::kSimCurrentPattern,
+      [this](const std::string& ch, const auvrl_lcm::water_current_t& m) { on_current(ch, m); },
+      &decode_stats_));
 
   const auto now = Clock::now();
   next_heartbeat_ = now;
@@ -258,6 +262,24 @@ void SimServer::on_fault(const std::string& channel, const auvrl_lcm::thruster_f
   ++counters_.faults_total;
 }
 
+void SimServer::on_current(const std::string& channel, const auvrl_lcm::water_current_t& msg) {
+  Vehicle* vehicle = addressed_vehicle(channel, msg.vehicle_id);
+  if (vehicle == nullptr) return;
+  const Eigen::Vector3d current_ned_mps(msg.current_constant_ned_mps[0],
+                                        msg.current_constant_ned_mps[1],
+                                        msg.current_constant_ned_mps[2]);
+  if (!current_ned_mps.allFinite()) {
+    ++counters_.dropped_non_finite;
+    return;
+  }
+  if (!vehicle->active) {
+    ++counters_.dropped_not_reset;
+    return;
+  }
+  set_constant_current(vehicle->state, current_ned_mps);
+  ++counters_.currents_total;
+}
+
 void SimServer::step_vehicle(int /*id*/, Vehicle& vehicle, const ThrusterVector& command_n) {
   const bool was_ok = vehicle.state.status == StateStatus::kOk;
   step(model_, vehicle.state, command_n);
@@ -325,6 +347,7 @@ void SimServer::publish_heartbeat() {
   hb.steps_per_s = steps_per_s_;
   hb.resets_total = counters_.resets_total;
   hb.faults_total = counters_.faults_total;
+  hb.currents_total = counters_.currents_total;
   hb.blow_ups_total = counters_.blow_ups_total;
   hb.duplicates_answered = counters_.duplicates_answered;
   hb.dropped_stale = counters_.dropped_stale;

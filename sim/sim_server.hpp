@@ -9,6 +9,7 @@
 #include <auvrl_lcm/thruster_fault_t.hpp>
 #include <auvrl_lcm/vehicle_reset_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
+#include <auvrl_lcm/water_current_t.hpp>
 #include <chrono>
 #include <string>
 #include <vector>
@@ -35,6 +36,7 @@ struct SimServerCounters {
   std::int64_t steps_total = 0;
   std::int64_t resets_total = 0;
   std::int64_t faults_total = 0;
+  std::int64_t currents_total = 0;
   std::int64_t blow_ups_total = 0;
   std::int64_t duplicates_answered = 0;
   std::int64_t dropped_decode = 0;
@@ -101,6 +103,7 @@ class SimServer {
   void on_command(const std::string& channel, const auvrl_lcm::thruster_cmd_t& msg);
   void on_reset(const std::string& channel, const auvrl_lcm::vehicle_reset_t& msg);
   void on_fault(const std::string& channel, const auvrl_lcm::thruster_fault_t& msg);
+  void on_current(const std::string& channel, const auvrl_lcm::water_current_t& msg);
   /// The vehicle a message addresses, or nullptr (counted) if the id is unknown or does not
   /// match the channel.
   Vehicle* addressed_vehicle(const std::string& channel, int vehicle_id);

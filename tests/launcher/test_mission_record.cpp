@@ -1,11 +1,14 @@
 // auvrl run's record of a mission in process: the mission start found from MISSION_STATUS, the
 // trajectory from it with the command in force, and the per-way-point rows (the controller's
-// tracker fed with the recorded states, the energy per way-point).
+// tracker fed with the recorded states, the energy per way-point); the events as applied.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 
+#include "child_process.hpp"
 #include "launcher/mission_record.hpp"
+#include "launcher/mission_replay.hpp"
 
 namespace {
 
@@ -115,3 +118,74 @@ TEST(AnalyseWaypoints, FeedsTheTrackerAndSumsTheEnergyOfEachWaypoint) {
 }
 
 }  // namespace
+
+// The events as the vehicle got them: the current at 0 set with the reset, each current message
+// one event and each fault message one event per thruster it changes, with the due time of the
+// mission's event it applies.
+TEST(MissionEventLog, TurnsFaultAndCurrentMessagesIntoTheMissionsEvents) {
+  agent::Mission mission;
+  agent::MissionEvent current0, current_later, fault_t1, fault_t2;
+  current0.kind = current_later.kind = agent::MissionEvent::Kind::kCurrent;
+  current0.current_ned_mps = {0.2, 0.0, 0.0};
+  current_later.time_s = 30.0;
+  fault_t1.time_s = 20.0;
+  fault_t1.thruster = 1;
+  fault_t1.efficiency = 0.1;
+  fault_t2.time_s = 40.0;
+  fault_t2.thruster = 1;
+  fault_t2.efficiency = 0.0;
+  mission.events = {current0, fault_t1, current_later, fault_t2};
+  launcher::MissionEventLog log(mission, {"A", "B"});
+  EXPECT_EQ(log.start_current_ned_mps(), Eigen::Vector3d(0.2, 0.0, 0.0));
+  ASSERT_EQ(log.events().size(), 1u);
+  EXPECT_EQ(log.events()[0].text,
+            "t=0 s: water current [0.2, 0, 0] m/s NED, set with the vehicle's reset");
+
+  auvrl_lcm::thruster_fault_t fault{};
+  fault.num_thrusters = 2;
+  fault.thruster_efficiency = {1.0, 0.1};
+  auto added = log.add_fault(fault, 20.04, "SIM_FAULT_0");
+  ASSERT_EQ(added.size(), 1u);
+  EXPECT_EQ(added[0].time_s, 20.04);
+  EXPECT_EQ(added[0].text,
+            "t=20.0 s (due at 20 s): thruster 1 (B) at 10 % efficiency, injected on SIM_FAULT_0");
+  EXPECT_TRUE(log.add_fault(fault, 20.1, "SIM_FAULT_0").empty()) << "a repeat changes nothing";
+  fault.thruster_efficiency = {0.5, 0.0};  // one of the mission's, one not
+  added = log.add_fault(fault, 41.0, "SIM_FAULT_0");
+  ASSERT_EQ(added.size(), 2u);
+  EXPECT_EQ(added[0].text,
+            "t=41.0 s (not one of the mission's events): thruster 0 (A) at 50 % efficiency, "
+            "injected on SIM_FAULT_0");
+  EXPECT_EQ(added[1].text,
+            "t=41.0 s (due at 40 s): thruster 1 (B) at 0 % efficiency, injected on SIM_FAULT_0");
+  fault.num_thrusters = 3;
+  fault.thruster_efficiency = {0.0, 0.0, 0.0};
+  EXPECT_TRUE(log.add_fault(fault, 42.0, "SIM_FAULT_0").empty()) << "another vehicle's count";
+  auvrl_lcm::water_current_t current{};  // the current at 30 s: zero
+  EXPECT_EQ(log.add_current(current, 30.05, "SIM_CURRENT_0").text,
+            "t=30.1 s (due at 30 s): water current [0, 0, 0] m/s NED, injected on SIM_CURRENT_0");
+  current.current_constant_ned_mps[1] = -0.25;
+  EXPECT_EQ(log.add_current(current, 50.0, "SIM_CURRENT_0").text,
+            "t=50.0 s (not one of the mission's events): water current [0, -0.25, 0] m/s NED, "
+            "injected on SIM_CURRENT_0");
+  EXPECT_EQ(log.events().size(), 6u);
+}
+
+// What a replay says of each file against the run's.
+TEST(CompareFiles, SaysWhereARunsFileAndItsReplayDiffer) {
+  const std::string dir = test_support::make_temp_dir("auvrl_compare_files_");
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir + "/" + name) << text;
+    return dir + "/" + name;
+  };
+  const std::string a = write("a.csv", "t,x\n0,1\n0.1,2\n");
+  EXPECT_EQ(launcher::compare_files(a, write("same.csv", "t,x\n0,1\n0.1,2\n")), "identical");
+  EXPECT_EQ(launcher::compare_files(a, write("b.csv", "t,x\n0,1\n0.1,3\n")),
+            "differs from line 3 (the run has 3 lines, the replay 3)");
+  EXPECT_EQ(launcher::compare_files(a, write("short.csv", "t,x\n0,1\n")),
+            "differs from line 3 (the run has 3 lines, the replay 2)");
+  EXPECT_EQ(launcher::compare_files(a, write("crlf.csv", "t,x\n0,1\n0.1,2")),
+            "the same lines, not the same bytes (line ends)");
+  EXPECT_EQ(launcher::compare_files(a, dir + "/none.csv"), "missing in the replay");
+  EXPECT_EQ(launcher::compare_files(dir + "/none.csv", a), "missing in the run");
+}

@@ -135,6 +135,32 @@ TEST_F(SimServerInput, OutOfRangeResetAndFaultValuesAreDropped) {
   EXPECT_EQ(c.faults_total, 0);
 }
 
+// A live current change (water_current_t, what `auvrl run` injects for a mission's current event)
+// sets the constant current of a running vehicle; NaN, a vehicle never reset and a mismatched id
+// are dropped and counted.
+TEST_F(SimServerInput, LiveCurrentChangesApplyAndBadOnesAreDropped) {
+  auvrl_lcm::water_current_t current{};
+  current.vehicle_id = 0;
+  current.current_constant_ned_mps[0] = 0.3;
+  send(channels::sim_current(0), current);  // before any reset
+  EXPECT_EQ(server_.counters().dropped_not_reset, 1);
+  send(channels::sim_reset(0), reset(0));
+  send(channels::sim_current(0), current);
+  const sim::VehicleState* vehicle = server_.vehicle(0);
+  EXPECT_EQ(vehicle->current.constant_velocity_ned_mps, Eigen::Vector3d(0.3, 0.0, 0.0));
+  EXPECT_EQ(vehicle->current_velocity_ned_mps, Eigen::Vector3d(0.3, 0.0, 0.0));
+  current.current_constant_ned_mps[1] = std::nan("");
+  send(channels::sim_current(0), current);
+  current.current_constant_ned_mps[1] = 0.0;
+  current.vehicle_id = 1;  // on vehicle 0's channel
+  send(channels::sim_current(0), current);
+  const auto c = server_.counters();
+  EXPECT_EQ(c.currents_total, 1);
+  EXPECT_EQ(c.dropped_non_finite, 1);
+  EXPECT_EQ(c.dropped_vehicle_id, 1);
+  EXPECT_EQ(vehicle->current.constant_velocity_ned_mps, Eigen::Vector3d(0.3, 0.0, 0.0));
+}
+
 TEST_F(SimServerInput, UnknownAndMismatchedVehicleIdsAreDropped) {
   send(channels::sim_reset(0), reset(0));
   send(channels::sim_reset(2), reset(2));                 // past the served range
