@@ -351,7 +351,7 @@ std::string robustness_comparison_markdown(const std::vector<GroupComparison>& c
     return std::isfinite(v) ? fmt::format("{:.{}f}", v, digits) : std::string("-");
   };
   std::string out = fmt::format(
-      "| group | held (policy / PID) | flips | time to reach [s] | thrust energy | hold error "
+      "| group | held (policy vs PID) | flips | time to reach [s] | thrust energy | hold error "
       "[m] (+{:g}) | smoothness (x{:g}) | all |\n|---|---|---|---|---|---|---|---|\n",
       bar.hold_margin_m, bar.smoothness_ratio);
   int passing = 0;
@@ -359,16 +359,16 @@ std::string robustness_comparison_markdown(const std::vector<GroupComparison>& c
     const GroupMetrics& p = c.policy;
     const GroupMetrics& r = c.reference;
     passing += c.passes() ? 1 : 0;
-    out += fmt::format("| {} | {}/{} / {}/{} {} | {} / {} {} | {} / {} {} | {} / {} {} | ", p.group,
-                       p.held, p.episodes, r.held, r.episodes, mark(c.held), p.flips, r.flips,
-                       mark(c.no_flip), num(p.mean_time_s, 1), num(r.mean_time_s, 1), mark(c.time),
-                       num(p.mean_energy, 1), num(r.mean_energy, 1), mark(c.energy));
-    out += fmt::format("{} / {} {} | {} / {} {} | {} |\n", num(p.mean_hold_m, 3),
+    out += fmt::format("| {} | {}/{} vs {}/{} {} | {} vs {} {} | {} vs {} {} | {} vs {} {} | ",
+                       p.group, p.held, p.episodes, r.held, r.episodes, mark(c.held), p.flips,
+                       r.flips, mark(c.no_flip), num(p.mean_time_s, 1), num(r.mean_time_s, 1),
+                       mark(c.time), num(p.mean_energy, 1), num(r.mean_energy, 1), mark(c.energy));
+    out += fmt::format("{} vs {} {} | {} vs {} {} | {} |\n", num(p.mean_hold_m, 3),
                        num(r.mean_hold_m, 3), mark(c.hold), num(p.mean_smoothness, 3),
                        num(r.mean_smoothness, 3), mark(c.smoothness), mark(c.passes()));
   }
   out += fmt::format(
-      "\n{} of {} groups pass every criterion. Each cell: policy / PID. Held: reached and "
+      "\n{} of {} groups pass every criterion. Each cell: policy vs PID. Held: reached and "
       "within 0.5 m at 70 s; time and hold error: means over the reached episodes; energy and "
       "smoothness: means over all.\n",
       passing, comparisons.size());
