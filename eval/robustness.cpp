@@ -575,6 +575,11 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
   config.seed = request.seed;
   std::unique_ptr<agent::Controller> controller = make_eval_controller(request, model, config);
   out << "vehicle " << describe(model.facts()) << "\n";
+  if (request.controller == "pid" || request.robustness_with_pid) {
+    const agent::VehiclePidGains gains = agent::pid_gains_for(model);
+    out << "PID gains: "
+        << (gains.from_file ? gains.file : "the compiled defaults (no " + gains.file + ")") << "\n";
+  }
   const auto run = [&](agent::Controller& c, const EvaluationConfig& cfg, const std::string& dir) {
     RobustnessResult r =
         run_robustness(model, cfg, c, request.robustness_episodes, request.seed, dir);
