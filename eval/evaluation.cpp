@@ -35,7 +35,8 @@ std::vector<std::string> summary_columns() {
   return {"scenario",      "controller",      "episode",
           "goal_x",        "goal_y",          "goal_z",
           "reached",       "time_to_reach_s", "mean_error_after_reach_m",
-          "final_error_m", "thrust_energy",   "end_reason"};
+          "final_error_m", "thrust_energy",   "end_reason",
+          "smoothness"};
 }
 
 std::vector<std::string> trajectory_columns(int num_thrusters) {
@@ -67,6 +68,8 @@ const char* to_string(Scenario scenario) {
       return "current";
     case Scenario::kSuite:
       return "suite";
+    case Scenario::kRobustness:
+      return "robustness";
   }
   return "?";
 }
@@ -76,8 +79,9 @@ std::vector<Scenario> parse_scenarios(const std::string& name) {
   for (Scenario s : kAllScenarios) {
     if (name == to_string(s)) return {s};
   }
-  throw std::invalid_argument("scenario '" + name +
-                              "': expected test1, test2, fault, current, suite or all");
+  throw std::invalid_argument(
+      "scenario '" + name +
+      "': expected test1, test2, fault, current, suite or all (auvrl eval: or robustness)");
 }
 
 const char* end_reason_name(task::EndReason reason) {
@@ -153,26 +157,48 @@ std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config,
       }
       return episodes;
     }
+    case Scenario::kRobustness:
+      throw std::invalid_argument(
+          "evaluation: the robustness suite's episodes come from robustness_episodes "
+          "(eval/robustness.hpp)");
   }
   return {};
+}
+
+double command_smoothness(const std::vector<std::vector<double>>& commands_normalised) {
+  double sum = 0.0;
+  std::size_t count = 0;
+  const std::vector<double>* previous = nullptr;
+  for (const std::vector<double>& command : commands_normalised) {
+    for (std::size_t i = 0; i < command.size(); ++i) {
+      const double before =
+          previous && i < previous->size() ? (*previous)[i] : 0.0;  // from zero at first
+      sum += std::abs(command[i] - before);
+    }
+    count += command.size();
+    previous = &command;
+  }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
                                   agent::Controller& controller, const EvaluationEpisode& episode,
                                   std::vector<agent::TrajectoryRow>* trajectory) {
   std::unique_ptr<agent::VehicleLink> link = agent::make_in_process_link(model);
-  if (trajectory) {
-    // The reset state as the first row (run_episode records from the first step on); the
-    // in-process link is deterministic, so run_episode's own reset gives the same state.
-    trajectory->clear();
-    const std::optional<agent::VehicleReport> first = link->reset(episode.start);
-    if (first) {
-      const auto n = static_cast<std::size_t>(model.num_thrusters());
-      trajectory->push_back({first->time_s, first->observation, std::vector<double>(n, 0.0),
-                             first->thrust_realised_n,
-                             (episode.goal_ned_m - first->observation.position_ned_m).norm()});
-    }
+  // The commands are always recorded: the smoothness is computed from them.
+  std::vector<agent::TrajectoryRow> own_trajectory;
+  if (!trajectory) trajectory = &own_trajectory;
+  // The reset state as the first row (run_episode records from the first step on); the
+  // in-process link is deterministic, so run_episode's own reset gives the same state.
+  trajectory->clear();
+  const std::optional<agent::VehicleReport> first = link->reset(episode.start);
+  if (first) {
+    const auto n = static_cast<std::size_t>(model.num_thrusters());
+    trajectory->push_back({first->time_s, first->observation, std::vector<double>(n, 0.0),
+                           first->thrust_realised_n,
+                           (episode.goal_ned_m - first->observation.position_ned_m).norm()});
   }
+  const std::size_t first_step = trajectory->size();
   agent::EpisodeOptions options;
   options.goal_ned_m = episode.goal_ned_m;
   options.beta_m = config.reach_radius_m;
@@ -182,10 +208,19 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   options.trajectory = trajectory;
   task::TaskConfig task = config.task;
   task.max_steps = config.episode_steps;
+  if (episode.safety_radius_m > 0.0) task.beta_max_m = episode.safety_radius_m;
   const agent::EpisodeSummary s = agent::run_episode(task, *link, controller, options);
 
+  std::vector<std::vector<double>> commands;
+  commands.reserve(trajectory->size());
+  for (std::size_t i = first_step; i < trajectory->size(); ++i) {
+    std::vector<double> u = (*trajectory)[i].thrust_command_n;
+    for (double& f : u) f /= task.max_thrust_n;
+    commands.push_back(std::move(u));
+  }
+
   SummaryRow row;
-  row.scenario = to_string(episode.scenario);
+  row.scenario = episode.group.empty() ? to_string(episode.scenario) : episode.group;
   row.controller = controller.name();
   row.episode = episode.index;
   row.goal_ned_m = episode.goal_ned_m;
@@ -195,6 +230,7 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   row.final_error_m = s.final_distance_m;
   row.thrust_energy = s.thrust_energy;
   row.end_reason = s.end_reason;
+  row.smoothness = command_smoothness(commands);
   return row;
 }
 
@@ -292,6 +328,7 @@ void write_summary_csv(const std::string& path, const std::vector<SummaryRow>& r
       out.empty().empty();  // never reached: both cells empty
     }
     out.cell(r.final_error_m).cell(r.thrust_energy).cell(end_reason_name(r.end_reason));
+    out.cell(r.smoothness);
     out.end_row();
   }
   out.flush();
@@ -350,7 +387,7 @@ void write_trajectory_csv(const std::string& path, const std::vector<agent::Traj
 std::string format_summary_table(const std::vector<SummaryRow>& rows) {
   struct Totals {
     int episodes = 0, reached = 0;
-    double time = 0, hold = 0, final_error = 0, energy = 0;
+    double time = 0, hold = 0, final_error = 0, energy = 0, smoothness = 0;
     std::string controller;
   };
   std::vector<std::string> order;
@@ -367,10 +404,11 @@ std::string format_summary_table(const std::vector<SummaryRow>& rows) {
     }
     t.final_error += r.final_error_m;
     t.energy += r.thrust_energy;
+    t.smoothness += r.smoothness;
   }
   std::string out =
-      fmt::format("{:<9}{:<12}{:>10}{:>13}{:>14}{:>15}{:>10}\n", "scenario", "controller",
-                  "reached", "time [s]", "hold err [m]", "final err [m]", "energy");
+      fmt::format("{:<9}{:<12}{:>10}{:>13}{:>14}{:>15}{:>10}{:>8}\n", "scenario", "controller",
+                  "reached", "time [s]", "hold err [m]", "final err [m]", "energy", "smooth");
   for (const std::string& name : order) {
     const Totals& t = by_scenario[name];
     out += fmt::format("{:<9}{:<12}{:>10}", name, t.controller,
@@ -380,12 +418,14 @@ std::string format_summary_table(const std::vector<SummaryRow>& rows) {
     } else {
       out += fmt::format("{:>13}{:>14}", "-", "-");
     }
-    out += fmt::format("{:>15.2f}{:>10.1f}\n", t.final_error / t.episodes, t.energy / t.episodes);
+    out += fmt::format("{:>15.2f}{:>10.1f}{:>8.3f}\n", t.final_error / t.episodes,
+                       t.energy / t.episodes, t.smoothness / t.episodes);
   }
   out +=
       "time and hold error: means over the reached episodes (reached = within 0.5 m);\n"
-      "final error and energy: means over all episodes; energy = sum over 0.1 s steps of "
-      "the\nmean squared normalised thruster command.\n";
+      "final error, energy and smoothness: means over all episodes; energy = sum over 0.1 s\n"
+      "steps of the mean squared normalised thruster command; smooth = mean |change of the\n"
+      "normalised command| per step and thruster.\n";
   return out;
 }
 

@@ -11,6 +11,9 @@
 //            start->goal line, pointing to its right (bearing of the line + 90 deg);
 //   suite    100 way-points drawn by task::sample_goal from the training region with a fixed
 //            seed, from the fixed start.
+// The robustness suite (starts, far way-points, faults, currents, sensor noise, a wrong
+// model; eval/robustness.hpp) runs its episodes through run_evaluation_episode too; `all` is
+// the five above.
 //
 // Files written to DIR:
 //   vehicle.csv    the vehicle and its thrusters (write_vehicle_csv)
@@ -20,7 +23,10 @@
 //                  that moment to the end; EMPTY if never), final_error_m, thrust_energy (sum
 //                  over the 0.1 s steps of the mean squared normalised command: six thrusters
 //                  at full thrust for 70 s give 700), end_reason (time_limit, left_region,
-//                  flipped, blow_up, sim_timeout; reached only if the last step was inside).
+//                  flipped, blow_up, sim_timeout; reached only if the last step was inside),
+//                  smoothness (command_smoothness: mean over the steps and thrusters of the
+//                  absolute change of the normalised command, the first step's counted from
+//                  zero).
 //   trajectories/<scenario>_<episode>.csv   one row per control step, the first (t = 0) the
 //                  state after the reset: t, x, y, z, phi, theta, psi, u, v, w, p, q, r,
 //                  cmd_1..cmd_n (commanded thrust, N), thrust_1..thrust_n (realised thrust, N:
@@ -43,12 +49,14 @@
 
 namespace auvrl::eval {
 
-/// One evaluation scenario (see the file comment).
-enum class Scenario { kTest1, kTest2, kFault, kCurrent, kSuite };
+/// One evaluation scenario (see the file comment). kRobustness marks the robustness suite's
+/// episodes (eval/robustness.hpp), which scenario_episodes and parse_scenarios do not give.
+enum class Scenario { kTest1, kTest2, kFault, kCurrent, kSuite, kRobustness };
 
 const char* to_string(Scenario scenario);
 /// "test1", "test2", "fault", "current", "suite", or "all" (the five in that order); throws
-/// std::invalid_argument naming the accepted names otherwise.
+/// std::invalid_argument naming the accepted names otherwise (`auvrl eval` takes
+/// "robustness" before asking).
 std::vector<Scenario> parse_scenarios(const std::string& name);
 
 /// Everything that defines an evaluation besides the controller and the vehicle.
@@ -76,10 +84,17 @@ struct EvaluationEpisode {
   int index = 0;  ///< episode number within the scenario, from 0
   Eigen::Vector3d goal_ned_m = Eigen::Vector3d::Zero();
   agent::EpisodeStart start;
+  /// The robustness group (eval/robustness.hpp) that names the episode's row in place of the
+  /// scenario; empty for the scenarios.
+  std::string group;
+  /// Radius of the safety sphere around the way-point (the task's beta_max_m), m; 0: the
+  /// task's. Way-points farther than it from the start need a larger one.
+  double safety_radius_m = 0.0;
 };
 
 /// The episodes of a scenario (one for the paper's tests, suite_episodes for the suite).
-/// Throws std::invalid_argument if the fault thruster is not one of the task's thrusters.
+/// Throws std::invalid_argument if the fault thruster is not one of the task's thrusters, or
+/// for kRobustness (robustness_episodes draws those).
 std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config, Scenario scenario);
 
 /// One row of summary.csv (see the file comment for units and empty cells).
@@ -94,13 +109,20 @@ struct SummaryRow {
   double final_error_m = 0.0;
   double thrust_energy = 0.0;
   task::EndReason end_reason = task::EndReason::kNone;
+  double smoothness = 0.0;  ///< command_smoothness of the episode's commands
 };
+
+/// Mean over the steps and the thrusters of |u_t,i - u_t-1,i|, the change of the normalised
+/// command (commanded thrust / maximum thrust, in [-1, 1]) from one 0.1 s step to the next;
+/// the first step's change is counted from zero (the thrusters are off at the reset). One row
+/// per step; 0 for no steps. Bang-bang between full ahead and astern every step gives 2.
+double command_smoothness(const std::vector<std::vector<double>>& commands_normalised);
 
 /// Name of an end reason as written in summary.csv.
 const char* end_reason_name(task::EndReason reason);
 
 /// Runs one episode in process; fills `trajectory` (when given) with the reset state first,
-/// then one row per control step.
+/// then one row per control step. The row's scenario is the episode's group when it has one.
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
                                   agent::Controller& controller, const EvaluationEpisode& episode,
                                   std::vector<agent::TrajectoryRow>* trajectory);
@@ -152,7 +174,7 @@ void write_trajectory_csv(const std::string& path, const std::vector<agent::Traj
                           int num_thrusters, const std::vector<int>* waypoint_index = nullptr);
 
 /// One screen of text: per scenario, episodes, reached count, mean time to reach and mean
-/// hold error over the reached episodes, mean final error and mean thrust energy.
+/// hold error over the reached episodes, mean final error, thrust energy and smoothness.
 std::string format_summary_table(const std::vector<SummaryRow>& rows);
 
 /// The state layout of a policy network (task::infer_layout).
@@ -174,6 +196,10 @@ struct EvalRequest {
   std::uint64_t seed = 1;
   int suite_episodes = 100;
   int suite_trajectories = 10;
+  /// scenario "robustness" (eval/robustness.hpp): episodes per group, and whether a policy is
+  /// also compared with the PID baseline on the same episodes.
+  int robustness_episodes = 20;
+  bool robustness_with_pid = false;
 };
 
 /// Builds the controller for a request: loads and checks the policy file (errors name the

@@ -13,6 +13,7 @@
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/mission_run.hpp"
+#include "eval/robustness.hpp"
 #include "launcher/config_doc.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/mission_replay.hpp"
@@ -37,12 +38,15 @@ int run_eval(int argc, const char* const* argv) {
       "Runs a controller on the evaluation scenarios in process (no noise, the full 70 s each)\n"
       "and writes DIR/summary.csv and DIR/trajectories/<scenario>_<episode>.csv.\n"
       "Scenarios: test1, test2 (facing away), fault (T1 at 10 %), current (0.3 m/s across),\n"
-      "suite (random way-points of the training region), all.\n"
+      "suite (random way-points of the training region), all (those five).\n"
+      "--scenario robustness runs the robustness suite instead (starts, far way-points, weak\n"
+      "and dead thrusters, currents, sensor noise, a wrong model; --robustness-episodes per\n"
+      "group, seed --seed) and writes DIR/robustness.csv and DIR/robustness_episodes.csv.\n"
       "With --mission FILE it runs that mission (config/missions/*.yaml, docs/missions.md)\n"
       "instead and writes DIR/mission.csv and DIR/trajectory.csv.");
   cli.option("policy", &request.policy_path, "policy network file (nn format)");
   cli.option("controller", &request.controller, "policy or pid");
-  cli.option("scenario", &request.scenario, "test1|test2|fault|current|suite|all");
+  cli.option("scenario", &request.scenario, "test1|test2|fault|current|suite|all|robustness");
   cli.option("out", &request.out_dir, "output directory (created)");
   cli.custom_option(
       "vehicle",
@@ -62,10 +66,17 @@ int run_eval(int argc, const char* const* argv) {
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
   cli.option("suite-trajectories", &request.suite_trajectories,
              "trajectory files for the first N suite episodes (-1: all)");
+  cli.option("robustness-episodes", &request.robustness_episodes,
+             "episodes per group of the robustness suite");
+  cli.flag("with-pid", &request.robustness_with_pid,
+           "robustness: also run the PID on the same episodes (DIR/pid/) and write "
+           "DIR/robustness_comparison.md");
   if (!cli.parse(argc, argv)) return 0;
   request.seed = static_cast<std::uint64_t>(seed);
   if (!request.mission_path.empty()) {
     auvrl::eval::run_mission_request(request, std::cout);
+  } else if (request.scenario == "robustness") {
+    auvrl::eval::run_robustness_request(request, std::cout);
   } else {
     auvrl::eval::run_eval_request(request, std::cout);
   }

@@ -134,6 +134,26 @@ EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy
   result.pid_rows =
       eval::run_evaluation(ctx.model, pid_config, *pid, all, (eval_dir / "pid").string());
   std::ofstream(eval_dir / "selected_policy.txt") << policy_path << "\n";
+  try {
+    const eval::RobustnessResult p =
+        eval::run_robustness(ctx.model, config, policy, eval::kRobustnessEpisodesPerGroup,
+                             config.seed, (eval_dir / "policy").string());
+    const eval::RobustnessResult r =
+        eval::run_robustness(ctx.model, pid_config, *pid, eval::kRobustnessEpisodesPerGroup,
+                             config.seed, (eval_dir / "pid").string());
+    result.robustness = eval::compare_robustness(p.groups, r.groups);
+    result.robustness_policy_s = p.elapsed_s;
+    result.robustness_pid_s = r.elapsed_s;
+    eval::write_robustness_comparison((eval_dir / "robustness_comparison.md").string(),
+                                      result.robustness);
+    out << fmt::format(
+        "auvrl train: robustness suite: {} episodes each, policy {:.1f} s, PID {:.1f} s\n",
+        p.rows.size(), p.elapsed_s, r.elapsed_s);
+  } catch (const std::exception& e) {
+    // The scenarios' evaluation stands: the report names the missing robustness files.
+    out << "auvrl train: robustness suite failed: " << e.what() << "\n";
+    result.robustness.clear();
+  }
   return result;
 }
 
@@ -148,8 +168,23 @@ void report_stage(const RunContext& ctx, const std::string& policy_path,
   }
   out << "\nlearned policy (" << policy_path << "):\n"
       << eval::format_summary_table(result.policy_rows) << "\nPID baseline:\n"
-      << eval::format_summary_table(result.pid_rows)
-      << "\nreport: " << (fs::path(ctx.run_dir) / "report.md").string() << "\n";
+      << eval::format_summary_table(result.pid_rows);
+  if (!result.robustness.empty()) {
+    std::string failing;
+    int passing = 0;
+    for (const eval::GroupComparison& c : result.robustness) {
+      if (c.passes()) {
+        ++passing;
+      } else {
+        failing += (failing.empty() ? "" : ", ") + c.policy.group;
+      }
+    }
+    out << fmt::format("\nrobustness suite against the PID: {} of {} groups pass the bar{}{}\n",
+                       passing, result.robustness.size(), failing.empty() ? "" : "; not: ", failing)
+        << "  (table: " << (fs::path(ctx.run_dir) / "eval" / "robustness_comparison.md").string()
+        << ")\n";
+  }
+  out << "\nreport: " << (fs::path(ctx.run_dir) / "report.md").string() << "\n";
 }
 
 }  // namespace auvrl::launcher

@@ -9,6 +9,7 @@
 
 #include "eval/evaluation.hpp"
 #include "eval/quick_evaluator.hpp"
+#include "eval/robustness.hpp"
 #include "launcher/best_policy.hpp"
 #include "launcher/telemetry.hpp"
 #include "launcher/training.hpp"
@@ -44,18 +45,26 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
                                    std::ostream& out);
 
-/// The evaluation of a policy and of the PID baseline on every scenario.
+/// The evaluation of a policy and of the PID baseline on every scenario and on the robustness
+/// suite.
 struct EvaluationResult {
   std::vector<eval::SummaryRow> policy_rows;
   std::vector<eval::SummaryRow> pid_rows;
+  /// The robustness suite, policy against the PID group by group (empty when it failed).
+  std::vector<eval::GroupComparison> robustness;
+  double robustness_policy_s = 0.0;  ///< wall-clock time of the policy's suite, s
+  double robustness_pid_s = 0.0;     ///< and of the PID's
 };
 
-/// Evaluates the policy at policy_path and the PID baseline into <run_dir>/eval/.
+/// Evaluates the policy at policy_path and the PID baseline into <run_dir>/eval/: the five
+/// scenarios (summary.csv, trajectories/), then the robustness suite (robustness.csv,
+/// robustness_episodes.csv, and eval/robustness_comparison.md). A failure of the robustness
+/// suite is reported on `out` and costs only its files.
 EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy_path,
                                 std::ostream& out);
 
-/// Draws the plots (scripts/plot_run.py, which also writes report.md) and prints the summary
-/// tables.
+/// Draws the plots (scripts/plot_run.py, which also writes report.md with the robustness
+/// table and figure) and prints the summary tables and the robustness verdict.
 void report_stage(const RunContext& ctx, const std::string& policy_path,
                   const EvaluationResult& result, std::ostream& out);
 

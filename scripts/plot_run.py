@@ -5,11 +5,15 @@ Usage: /usr/bin/python3 scripts/plot_run.py RUN
 
 RUN is what `auvrl train` writes (or any directory holding part of it):
   RUN/eval/<controller>/summary.csv and trajectories/<scenario>_<episode>.csv   (auvrl eval)
+  RUN/eval/{policy,pid}/robustness.csv, RUN/eval/robustness_comparison.md   (robustness suite)
   RUN/episodes.csv, RUN/learner.csv, RUN/progress.csv                            (training)
-An `auvrl eval --out DIR` directory (summary.csv directly inside) is taken as one controller.
+An `auvrl eval --out DIR` directory (summary.csv directly inside) is taken as one controller;
+one of `auvrl eval --scenario robustness --with-pid` (robustness.csv, pid/robustness.csv and
+robustness_comparison.md) gives the robustness section.
 
 Writes RUN/plots/*.png (the paper's Fig. 3-8 for test1, test2 and fault, the same for the
-current scenario, a suite overview, learning curves against episodes and wall-clock time) and
+current scenario, a suite overview, the robustness suite against the PID
+(scripts/plot_robustness.py), learning curves against episodes and wall-clock time) and
 RUN/report.md (tables and the figures). Missing inputs are named in the report and skipped;
 malformed rows are reported with file and line and skipped. Exit 0 on success, 2 when RUN is
 not a directory, 1 when the outputs cannot be written.
@@ -55,7 +59,7 @@ DIST_FLOOR = 1e-5  # distances below are drawn at this value on log axes
 # Plot files this script writes; stale ones (from an earlier call with more inputs) are removed.
 OWN_PLOTS = [f"eval_{s}_{k}.png" for s in PAPER_SCENARIOS for k in ("3d", "position",
                                                                          "thrusters")]
-OWN_PLOTS += ["eval_distance.png", "suite_overview.png", "suite_3d.png",
+OWN_PLOTS += ["eval_distance.png", "suite_overview.png", "suite_3d.png", "robustness.png",
               "training_vs_episodes.png", "training_vs_time.png"]
 
 
@@ -318,6 +322,40 @@ def find_controllers(run):
         if c.color is None:
             c.color = next(extra, "tab:gray")
     return ctrls
+
+
+def robustness_paths(run):
+    """[policy robustness.csv, PID robustness.csv, comparison .md] of a run (RUN/eval/...), or
+    of an `auvrl eval --scenario robustness --with-pid` directory when the run has none."""
+    layouts = [[os.path.join(run, "eval", "policy", "robustness.csv"),
+                os.path.join(run, "eval", "pid", "robustness.csv"),
+                os.path.join(run, "eval", "robustness_comparison.md")],
+               [os.path.join(run, "robustness.csv"), os.path.join(run, "pid", "robustness.csv"),
+                os.path.join(run, "robustness_comparison.md")]]
+    for paths in layouts:
+        if any(os.path.isfile(p) for p in paths):
+            return paths
+    return layouts[0]
+
+
+def robustness_inputs(run):
+    """robustness_paths(run), None for each file that is not there."""
+    return tuple(p if os.path.isfile(p) else None for p in robustness_paths(run))
+
+
+def plot_robustness_figure(run, plots_dir, written):
+    """plots/robustness.png from the two robustness.csv files (scripts/plot_robustness.py)."""
+    import plot_robustness  # beside this script
+    policy_csv, pid_csv, _ = robustness_inputs(run)
+    if not policy_csv or not pid_csv:
+        return
+    policy, pid = plot_robustness.read_groups(policy_csv), plot_robustness.read_groups(pid_csv)
+    if not policy or not pid:
+        NOTES.damage(f"{os.path.relpath(policy_csv if not policy else pid_csv, run)}: no "
+                     "readable rows; robustness figure skipped")
+        return
+    plot_robustness.draw(policy, pid, os.path.join(plots_dir, "robustness.png"))
+    written.append("robustness.png")
 
 
 def reach_time(ctrl, scenario, episode, traj):
@@ -1131,6 +1169,37 @@ def vehicle_of(ctrls):
     return ", ".join(names) if names else "nessie7"
 
 
+def robustness_section(run, L):
+    """The robustness suite's comparison table (robustness_comparison.md, written by auvrl),
+    or a note naming what is missing."""
+    policy_csv, pid_csv, comparison = robustness_inputs(run)
+    if not (policy_csv or pid_csv or comparison):
+        if os.path.isdir(os.path.join(run, "eval")):
+            NOTES.miss("eval/robustness_comparison.md (no robustness suite in this run)")
+        return
+    L.append("### Robustness")
+    L.append("")
+    L.append("The robustness suite (`auvrl eval --scenario robustness`, docs/usage.md): groups "
+             "of episodes from random headings that each change one thing (start, way-point "
+             "distance, a weak or dead thruster, current, sensor noise, a wrong model). The bar "
+             "a policy must clear in every group against the PID: held at least as often, no "
+             "flip, mean time to reach no later, thrust energy no more, hold error within "
+             "0.05 m of the PID's, smoothness at most twice the PID's.")
+    L.append("")
+    if comparison:
+        try:
+            with open(comparison, encoding="utf-8", errors="replace") as f:
+                L.append(f.read().strip())
+        except OSError as e:
+            NOTES.damage(f"{os.path.relpath(comparison, run)}: cannot read ({e})")
+    else:
+        NOTES.miss(f"{os.path.relpath(robustness_paths(run)[2], run)} (no comparison table)")
+    for path in robustness_paths(run)[:2]:
+        if not os.path.isfile(path):
+            NOTES.miss(f"{os.path.relpath(path, run)} (no robustness figure)")
+    L.append("")
+
+
 def write_report(run, ctrls, tr, figures, path):
     L = []
     now = datetime.datetime.now().strftime("%Y-%m-%d %H:%M")
@@ -1203,6 +1272,7 @@ def write_report(run, ctrls, tr, figures, path):
             L.append("Times and hold errors over the reached episodes; final error and "
                      "energy over all.")
             L.append("")
+    robustness_section(run, L)
 
     # --- Figures. ---
     L.append("## Figures")
@@ -1221,7 +1291,8 @@ def write_report(run, ctrls, tr, figures, path):
             L.append(f"![{s}: {what}](plots/{f})")
             L.append("")
     for f, title in (("eval_distance.png", "### Distance to the way-point, all scenarios"),
-                     ("suite_overview.png", "### Suite"), ("suite_3d.png", None)):
+                     ("suite_overview.png", "### Suite"), ("suite_3d.png", None),
+                     ("robustness.png", "### Robustness suite: policy against the PID")):
         if f in figures:
             if title:
                 L.append(title)
@@ -1331,6 +1402,8 @@ def run_job(job):
             plot_distance_overview(ctrls, plots_dir, written)
         elif kind == "suite":
             plot_suite(ctrls, plots_dir, written)
+        elif kind == "robustness":
+            plot_robustness_figure(CONTEXT["run"], plots_dir, written)
         elif kind == "training":
             plot_training(tr, plots_dir, written, modes=(arg,))
     except Exception as e:  # a figure must not cost the report
@@ -1362,8 +1435,10 @@ def main(argv):
     ctrls = find_controllers(run)
     check_and_load(ctrls)
     tr = Training(run)
-    CONTEXT.update(ctrls=ctrls, tr=tr, plots_dir=plots_dir)
+    CONTEXT.update(ctrls=ctrls, tr=tr, plots_dir=plots_dir, run=run)
     jobs = [("scenario", s) for s in PAPER_SCENARIOS] + [("distance", None), ("suite", None)]
+    if all(robustness_inputs(run)[:2]):
+        jobs.append(("robustness", None))
     if tr.any():
         jobs += [("training", "episodes"), ("training", "time")]
     results = None

@@ -109,7 +109,8 @@ TEST(Evaluation, WritesSummaryAndTrajectoriesWithTheRightColumns) {
       "scenario",      "controller",      "episode",
       "goal_x",        "goal_y",          "goal_z",
       "reached",       "time_to_reach_s", "mean_error_after_reach_m",
-      "final_error_m", "thrust_energy",   "end_reason"};
+      "final_error_m", "thrust_energy",   "end_reason",
+      "smoothness"};
   EXPECT_EQ(summary[0], header);
   EXPECT_EQ(summary[1][0], "test1");
   EXPECT_EQ(summary[1][1], "pid");
@@ -119,6 +120,10 @@ TEST(Evaluation, WritesSummaryAndTrajectoriesWithTheRightColumns) {
   EXPECT_EQ(summary[1][5], "10");
   EXPECT_EQ(summary[1][6], "1");
   EXPECT_NEAR(std::stod(summary[1][7]), rows[0].time_to_reach_s, 1e-6);
+  // Smoothness, the last column: the PID's commands change, by less than full scale a step.
+  EXPECT_NEAR(std::stod(summary[1][12]), rows[0].smoothness, 1e-6);
+  EXPECT_GT(rows[0].smoothness, 0.0);
+  EXPECT_LT(rows[0].smoothness, 0.5);
   EXPECT_EQ(summary[2][0], "fault");
   EXPECT_EQ(summary[5][0], "suite");
   EXPECT_EQ(summary[5][2], "2");
@@ -171,7 +176,7 @@ TEST(Evaluation, NeverReachedLeavesTheReachCellsEmpty) {
   write_summary_csv(dir.path("s.csv"), {row});
   const auto csv = read_csv(dir.path("s.csv"));
   ASSERT_EQ(csv.size(), 2u);
-  ASSERT_EQ(csv[1].size(), 12u);
+  ASSERT_EQ(csv[1].size(), 13u);
   EXPECT_EQ(csv[1][6], "0");
   EXPECT_EQ(csv[1][7], "");
   EXPECT_EQ(csv[1][8], "");

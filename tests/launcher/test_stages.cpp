@@ -1,14 +1,17 @@
-// The stages that run in process: the run directory and the processes' command lines.
+// The stages that run in process: the run directory, the processes' command lines, and the
+// evaluation stage (the scenarios and the robustness suite of the policy and the PID).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "child_process.hpp"
 #include "launcher/launcher.hpp"
+#include "launcher/pipeline.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/training.hpp"
 
@@ -56,6 +59,34 @@ TEST(RunDirectoryTest, OnlyFinishedCheckpointsCount) {
   std::ofstream(dir / "checkpoint-100.ckpt") << "x";
   EXPECT_TRUE(has_checkpoint_file(dir.string()));
   EXPECT_FALSE(has_checkpoint_file((dir / "missing").string()));
+}
+
+// The evaluation stage of `auvrl train` on the committed policy: the scenarios and the
+// robustness suite for both controllers, and the comparison table the report includes.
+TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_evalstage_");
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  prepare_run_directory(options);
+  const RunContext ctx = load_run_context(options);
+  std::ostringstream out;
+  const EvaluationResult result =
+      evaluate_stage(ctx, std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", out);
+  EXPECT_EQ(result.policy_rows.size(), 104u);  // four tests and the 100-way-point suite
+  EXPECT_EQ(result.pid_rows.size(), 104u);
+  ASSERT_EQ(result.robustness.size(), 25u) << out.str();
+  EXPECT_EQ(result.robustness[0].policy.controller, "policy");
+  EXPECT_EQ(result.robustness[0].reference.controller, "pid");
+  EXPECT_EQ(result.robustness[0].policy.episodes, 20);
+  EXPECT_GT(result.robustness_policy_s, 0.0);
+  EXPECT_GT(result.robustness_pid_s, 0.0);
+  for (const char* file : {"eval/policy/summary.csv", "eval/policy/robustness.csv",
+                           "eval/policy/robustness_episodes.csv", "eval/pid/robustness.csv",
+                           "eval/pid/robustness_episodes.csv", "eval/robustness_comparison.md"}) {
+    EXPECT_TRUE(fs::exists(tmp / "run" / file)) << file;
+  }
+  EXPECT_NE(out.str().find("robustness suite: 500 episodes each"), std::string::npos) << out.str();
 }
 
 class RolesTest : public ::testing::Test {

@@ -4,14 +4,15 @@
 Usage: /usr/bin/python3 test_plot_run.py [path/to/plot_run.py]   (CTest passes the path)
 
 The run directory is synthetic (written here, not by auvrl): a learned-policy and a PID
-evaluation with made-up numbers, training logs with a rising success rate. It contains damaged
-rows (a short row and an unreadable number in eval/policy/summary.csv, a bad number in
-episodes.csv and in a trajectory) and missing files (progress.csv, the PID's current-scenario
-trajectory). The test checks that the script exits 0, writes the expected figures, that
-report.md holds the table values computed from the fabricated rows, names the damaged rows by
-file and line and the missing files, and that its figure links resolve; and that a run
-directory with nothing in it, one of binary junk and non-finite numbers, and a path that is not
-a directory, are handled.
+evaluation with made-up numbers (and their robustness suites with auvrl's comparison table),
+training logs with a rising success rate. It contains damaged rows (a short row and an
+unreadable number in eval/policy/summary.csv, a bad number in episodes.csv and in a trajectory)
+and missing files (progress.csv, the PID's current-scenario trajectory). The test checks that
+the script exits 0, writes the expected figures, that report.md holds the table values
+computed from the fabricated rows and the robustness table, names the damaged rows by file and
+line and the missing files, and that its figure links resolve; and that a run directory with
+nothing in it, one of binary junk and non-finite numbers, and a path that is not a directory,
+are handled.
 Exits 77 (CTest: skipped) when Debian's python3-matplotlib or python3-numpy is missing.
 """
 import math
@@ -137,6 +138,18 @@ def fabricate(run):
         tail = f",{60 - (i == 10)},{9.5 - i / 100:.2f},0.08,1.1" if i % 10 == 0 else ",,,,"
         ft.append(f"{i},{10.0 - i / 20:.3f},{0.3 * i:.1f}" + tail)
     write(os.path.join(run, "finetune.csv"), "\n".join(ft) + "\n")
+    # ---- The robustness suite: two groups per controller and auvrl's comparison table. ----
+    rb = ("group,controller,episodes,reached,held,flips,blow_ups,left_region,"
+          "mean_time_to_reach_s,mean_hold_error_m,mean_thrust_energy,mean_smoothness,"
+          "description\n")
+    write(os.path.join(run, "eval/policy/robustness.csv"), rb +
+          "rest_start,policy,20,20,20,0,0,0,8.7,0.105,123.3,0.262,at rest\n"
+          "t1_0pct,policy,20,0,0,2,0,0,,,226.3,0.075,T1 dead\n")
+    write(os.path.join(run, "eval/pid/robustness.csv"), rb +
+          "rest_start,pid,20,20,20,0,0,0,11.9,0.047,58.2,0.008,at rest\n"
+          "t1_0pct,pid,20,20,20,0,0,0,12.2,0.046,58.3,0.008,T1 dead\n")
+    write(os.path.join(run, "eval/robustness_comparison.md"),
+          "| group | held (policy vs PID) |\n|---|---|\n| rest_start | 20/20 vs 20/20 pass |\n")
 
 
 class PlotRunTest(unittest.TestCase):
@@ -163,7 +176,7 @@ class PlotRunTest(unittest.TestCase):
     def test_figures_written(self):
         expected = [f"eval_{s}_{k}.png" for s in ("test1", "test2", "fault", "current")
                     for k in ("3d", "position", "thrusters")]
-        expected += ["eval_distance.png", "suite_overview.png", "suite_3d.png",
+        expected += ["eval_distance.png", "suite_overview.png", "suite_3d.png", "robustness.png",
                      "training_vs_episodes.png", "training_vs_time.png"]
         for name in expected:
             path = os.path.join(self.rundir, "plots", name)
@@ -177,6 +190,11 @@ class PlotRunTest(unittest.TestCase):
         self.assertGreaterEqual(len(links), 17)
         for link in links:
             self.assertTrue(os.path.isfile(os.path.join(self.rundir, link)), link)
+
+    def test_robustness_section(self):
+        self.assertIn("### Robustness\n", self.report)
+        self.assertIn("| rest_start | 20/20 vs 20/20 pass |", self.report)
+        self.assertIn("![robustness](plots/robustness.png)", self.report)
 
     def test_scenario_table(self):
         for row in (
