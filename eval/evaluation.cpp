@@ -181,6 +181,17 @@ double command_smoothness(const std::vector<std::vector<double>>& commands_norma
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
+double trajectory_smoothness(const std::vector<agent::TrajectoryRow>& rows, std::size_t first,
+                             double max_thrust_n) {
+  std::vector<std::vector<double>> commands;
+  for (std::size_t i = first; i < rows.size(); ++i) {
+    std::vector<double> u = rows[i].thrust_command_n;
+    for (double& f : u) f /= max_thrust_n;
+    commands.push_back(std::move(u));
+  }
+  return command_smoothness(commands);
+}
+
 SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const EvaluationConfig& config,
                                   agent::Controller& controller, const EvaluationEpisode& episode,
                                   std::vector<agent::TrajectoryRow>* trajectory) {
@@ -211,14 +222,6 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   if (episode.safety_radius_m > 0.0) task.beta_max_m = episode.safety_radius_m;
   const agent::EpisodeSummary s = agent::run_episode(task, *link, controller, options);
 
-  std::vector<std::vector<double>> commands;
-  commands.reserve(trajectory->size());
-  for (std::size_t i = first_step; i < trajectory->size(); ++i) {
-    std::vector<double> u = (*trajectory)[i].thrust_command_n;
-    for (double& f : u) f /= task.max_thrust_n;
-    commands.push_back(std::move(u));
-  }
-
   SummaryRow row;
   row.scenario = episode.group.empty() ? to_string(episode.scenario) : episode.group;
   row.controller = controller.name();
@@ -230,7 +233,7 @@ SummaryRow run_evaluation_episode(const sim::VehicleModel& model, const Evaluati
   row.final_error_m = s.final_distance_m;
   row.thrust_energy = s.thrust_energy;
   row.end_reason = s.end_reason;
-  row.smoothness = command_smoothness(commands);
+  row.smoothness = trajectory_smoothness(*trajectory, first_step, task.max_thrust_n);
   return row;
 }
 

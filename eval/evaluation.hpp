@@ -117,6 +117,10 @@ struct SummaryRow {
 /// the first step's change is counted from zero (the thrusters are off at the reset). One row
 /// per step; 0 for no steps. Bang-bang between full ahead and astern every step gives 2.
 double command_smoothness(const std::vector<std::vector<double>>& commands_normalised);
+/// command_smoothness of the rows' commanded thrusts from rows[first] on, each normalised by
+/// max_thrust_n.
+double trajectory_smoothness(const std::vector<agent::TrajectoryRow>& rows, std::size_t first,
+                             double max_thrust_n);
 
 /// Name of an end reason as written in summary.csv.
 const char* end_reason_name(task::EndReason reason);

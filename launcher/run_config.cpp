@@ -51,6 +51,10 @@ void add_objective_fields(config::Table<tuning::FinetuneConfig>& t) {
   t.field("pid_lag_weight", &C::pid_lag_weight, "s per s",
           "cost of arriving later than pid_lead_s before the PID baseline");
   t.field("pid_lead_s", &C::pid_lead_s, "s", "see pid_lag_weight");
+  t.field("energy_weight", &C::energy_weight, "s per unit of energy",
+          "price of thrust energy (sum of the mean squared normalised command per step)");
+  t.field("smoothness_weight", &C::smoothness_weight, "s per unit",
+          "price of the mean absolute change of the normalised command per step");
   t.field("integration_substeps", &C::integration_substeps, "0: the vehicle file's",
           "integrator steps per control step in the objective's episodes");
 }

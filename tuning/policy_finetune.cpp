@@ -41,6 +41,9 @@ void FinetuneConfig::validate() const {
   require(episode_steps >= 1, "episode_steps must be >= 1");
   require(std::isfinite(pid_lag_weight) && pid_lag_weight >= 0, "pid_lag_weight must be >= 0");
   require(std::isfinite(pid_lead_s), "pid_lead_s must be finite");
+  require(std::isfinite(energy_weight) && energy_weight >= 0, "energy_weight must be >= 0");
+  require(std::isfinite(smoothness_weight) && smoothness_weight >= 0,
+          "smoothness_weight must be >= 0");
   require(integration_substeps >= 0, "integration_substeps must be >= 0");
   require(threads >= 0, "threads must be >= 0");
 }
@@ -77,12 +80,28 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
   FinetuneConfig arrival_only = config;
   arrival_only.hold_weight = 0.0;
   arrival_only.flip_margin_weight = 0.0;
+  arrival_only.energy_weight = 0.0;
+  arrival_only.smoothness_weight = 0.0;
   arrival_only.pid_lag_weight = 0.0;
   agent::PidController pid(model, agent::pid_gains_for(model).gains);
   for (FinetuneEpisode& e : episodes) {
     e.pid_arrival_s = arrival_objective(model, task, pid, e, arrival_only);
   }
 }
+
+namespace {
+
+/// energy_weight x the episode's thrust energy plus smoothness_weight x its command smoothness
+/// (the trajectory's rows are its steps), s.
+double thrust_price_s(const agent::EpisodeSummary& summary,
+                      const std::vector<agent::TrajectoryRow>& trajectory, double max_thrust_n,
+                      const FinetuneConfig& config) {
+  if (config.energy_weight == 0.0 && config.smoothness_weight == 0.0) return 0.0;
+  return config.energy_weight * summary.thrust_energy +
+         config.smoothness_weight * eval::trajectory_smoothness(trajectory, 0, max_thrust_n);
+}
+
+}  // namespace
 
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
                          agent::Controller& controller, const FinetuneEpisode& episode,
@@ -103,7 +122,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   std::vector<agent::TrajectoryRow> trajectory;
   options.trajectory = &trajectory;
   std::unique_ptr<agent::VehicleLink> link = agent::make_in_process_link(plant);
-  agent::run_episode(t, *link, controller, options);
+  const agent::EpisodeSummary summary = agent::run_episode(t, *link, controller, options);
 
   const double dt = plant.control_step_s;
   double tilt_rad = 0.0;
@@ -112,7 +131,8 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
                          std::abs(row.observation.euler_rpy_rad[1])});
   }
   const double margin_s =
-      config.flip_margin_weight * std::max(0.0, tilt_rad - config.flip_margin_rad);
+      config.flip_margin_weight * std::max(0.0, tilt_rad - config.flip_margin_rad) +
+      thrust_price_s(summary, trajectory, plant.thruster_dynamics.max_thrust_n, config);
   // Time behind the PID's arrival less the lead asked for, if any.
   auto lag_s = [&](double arrival_s) {
     if (!std::isfinite(episode.pid_arrival_s)) return 0.0;

@@ -64,6 +64,14 @@ struct FinetuneConfig {
   /// with the PID per scenario.
   double pid_lag_weight = 0.0;
   double pid_lead_s = 0.0;
+  /// Plus energy_weight s per unit of thrust energy (the evaluation's: the sum over the
+  /// episode's control steps of the mean squared normalised command) and smoothness_weight s
+  /// per unit of the episode's command smoothness (eval::command_smoothness: the mean absolute
+  /// change of the normalised command per step and thruster). Both over the episode as it runs,
+  /// to hold_steps after the arrival or to its end: the objective can price thrust and chatter
+  /// as well as time.
+  double energy_weight = 0.0;
+  double smoothness_weight = 0.0;
   int threads = 2;  ///< policies evaluated at once (0: one per CPU)
 
   /// Throws std::invalid_argument naming the first setting out of range.

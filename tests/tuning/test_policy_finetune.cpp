@@ -1,7 +1,7 @@
 // Evolution-strategies fine-tuning (tuning/policy_finetune.hpp): its way-points, the per-way-point
 // objective against the evaluation's own figures (its PID lag term and its coarser integrator
 // too), that it lowers the objective of a trained policy, that the thread count does not change
-// the result, and that bad settings are refused.
+// the result, that bad settings are refused, and its prices of thrust energy and command changes.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -117,6 +117,42 @@ TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
   no_reference.pid_arrival_s = std::numeric_limits<double>::quiet_NaN();
   c.pid_lead_s = 0.3;
   EXPECT_EQ(arrival_objective(nessie(), t, pid, no_reference, c), pid_arrival_s);
+}
+
+// The thrust prices add energy_weight x the episode's thrust energy and smoothness_weight x its
+// command smoothness, both as the evaluation measures them over the same steps.
+TEST(ArrivalObjective, PricesTheEpisodesThrustEnergyAndCommandChanges) {
+  const task::TaskConfig t = fast_task();
+  FinetuneConfig c;
+  c.episode_steps = 300;
+  FinetuneEpisode e;
+  e.goal_ned_m = Eigen::Vector3d(7.0, 6.0, 10.0);
+  agent::PidController pid(nessie(), agent::pid_gains_for(nessie()).gains);
+  const double base = arrival_objective(nessie(), t, pid, e, c);
+  // The same episode run as the objective runs it, for its energy and smoothness.
+  task::TaskConfig et = t;
+  et.max_steps = c.episode_steps;
+  agent::EpisodeOptions options;
+  options.goal_ned_m = e.goal_ned_m;
+  options.beta_m = 0.5;
+  options.start = e.start;
+  options.reach_radius_m = 0.5;
+  options.run_full_time = true;
+  options.steps_after_reach = c.hold_steps;
+  std::vector<agent::TrajectoryRow> trajectory;
+  options.trajectory = &trajectory;
+  auto link = agent::make_in_process_link(nessie());
+  const agent::EpisodeSummary s = agent::run_episode(et, *link, pid, options);
+  const double smoothness = eval::trajectory_smoothness(trajectory, 0, t.max_thrust_n);
+  ASSERT_GT(s.thrust_energy, 1.0);
+  ASSERT_GT(smoothness, 0.0);
+  c.energy_weight = 0.1;
+  EXPECT_NEAR(arrival_objective(nessie(), t, pid, e, c), base + 0.1 * s.thrust_energy, 1e-9);
+  c.energy_weight = 0.0;
+  c.smoothness_weight = 50.0;
+  EXPECT_NEAR(arrival_objective(nessie(), t, pid, e, c), base + 50.0 * smoothness, 1e-9);
+  c.smoothness_weight = -1.0;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
 /// Never pushes.
