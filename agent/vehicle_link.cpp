@@ -28,6 +28,24 @@ void expect_vehicle(const VehicleFacts& expected, const auvrl_lcm::vehicle_state
   }
 }
 
+void apply_conditions(const task::EpisodeConditions& c, EpisodeStart& start) {
+  start.thruster_efficiency = c.thruster_efficiency;
+  start.current_ned_mps = c.current_ned_mps;
+  start.current_varying_sigma_mps = c.varying_current_sigma_mps;
+  start.current_varying_time_constant_s = c.varying_current_time_constant_s;
+  start.current_varying_direction_rad = c.varying_current_direction_rad;
+  start.sensor_noise.position_sigma_m = c.noise_position_m;
+  start.sensor_noise.attitude_sigma_rad = c.noise_attitude_rad;
+  start.sensor_noise.linear_velocity_sigma_mps = c.noise_velocity_mps;
+  start.sensor_noise.angular_velocity_sigma_rad_s = c.noise_angular_rate_rad_s;
+  sim::ModelVariation& v = start.model_variation;
+  v.quadratic_damping_scale = c.quadratic_damping_scale;
+  v.added_mass_scale = c.added_mass_scale;
+  v.mass_scale = c.mass_scale;
+  v.thruster_lag_time_constant_s = c.thruster_lag_time_constant_s;
+  v.extra_buoyancy_n = c.extra_buoyancy_n;
+}
+
 namespace {
 
 class InProcessLink final : public VehicleLink {

@@ -91,6 +91,7 @@ void TaskConfig::validate() const {
   }
   spread(start_velocity_max_body_mps, 5.0, "start_velocity_max_body_mps");
   spread(start_rate_max_body_rad_s, 2.0, "start_rate_max_body_rad_s");
+  randomise.validate();
   if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
       !goal_max_ned_m.allFinite() || (goal_max_ned_m - goal_min_ned_m).minCoeff() < 0) {
     throw std::invalid_argument("task: goal region must be finite with min <= max");

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/task/randomisation.hpp"
 #include "common/vehicle_facts.hpp"
 
 namespace auvrl::config {
@@ -119,6 +120,10 @@ struct TaskConfig {
   Eigen::Vector3d start_attitude_spread_rad = Eigen::Vector3d::Zero();    ///< roll, pitch, yaw
   Eigen::Vector3d start_velocity_max_body_mps = Eigen::Vector3d::Zero();  ///< u, v, w
   Eigen::Vector3d start_rate_max_body_rad_s = Eigen::Vector3d::Zero();    ///< p, q, r
+
+  /// Randomised training episodes (training only, like the exploring starts): faults, currents,
+  /// sensor noise and model variation drawn per episode by the actors (randomisation.hpp).
+  EpisodeRandomisation randomise;
 
   /// Size of the observation vector.
   int state_dim() const;
