@@ -103,6 +103,9 @@ void add_reward_fields(config::Table<TaskConfig>& t) {
   t.field("precision_reward", &C::precision_reward, "per step",
           "shaped reward: +precision_reward * exp(-d / precision_scale_m)");
   t.field("precision_scale_m", &C::precision_scale_m, "m", "scale of the precision term");
+  t.field("command_change_weight", &C::command_change_weight, "0: off",
+          "price of command changes: -w * mean((u_t - u_t-1)^2) per step (u_t-1 is in the state)")
+      .range(0.0);
 }
 
 /// Episode length, start and goal region.
