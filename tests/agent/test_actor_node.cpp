@@ -234,6 +234,26 @@ TEST_F(ActorDemonstrations, RandomisedEpisodesReachTheSimulatorAndLeaveTheGoalsA
   }
 }
 
+// The paper and fast presets randomise nothing (the paper's stays literal); robust.yaml turns
+// every kind on.
+TEST(ActorConfigFile, OnlyTheRobustPresetRandomisesEpisodes) {
+  for (const std::string preset : {"paper", "fast", "robust"}) {
+    ActorNodeConfig c;
+    read_actor_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml", c);
+    const task::EpisodeRandomisation& r = c.task.randomise;
+    if (preset != "robust") {
+      EXPECT_FALSE(r.any()) << preset;
+      EXPECT_EQ(c.task.command_change_weight, 0.0) << preset;
+      continue;
+    }
+    for (double p : {r.fault_probability, r.current_probability, r.varying_current_probability,
+                     r.sensor_noise_probability, r.model_probability}) {
+      EXPECT_GT(p, 0.0);
+    }
+    EXPECT_NO_THROW(c.task.validate());
+  }
+}
+
 TEST(ActorConfigFile, ReadsDemonstrationsExpertLabelsAndTheVehicle) {
   const std::string path = testing::TempDir() + "actor_demonstrations.yaml";
   const auto write = [&](const std::string& fraction) {

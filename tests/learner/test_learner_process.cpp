@@ -76,5 +76,20 @@ TEST(LearnerSection, ReadsTheSmoothnessTermsAndRefusesNegativeWeightsNamingTheKe
   }
 }
 
+// The smoothness terms are off in the paper and fast presets, on in robust.yaml.
+TEST(LearnerSection, OnlyTheRobustPresetSmoothsTheCommands) {
+  for (const std::string preset : {"paper", "fast", "robust"}) {
+    LearnerNodeConfig config;
+    read_learner_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml",
+                             config);
+    const bool on =
+        config.ddpg.smooth_temporal_weight > 0.0f && config.ddpg.smooth_spatial_weight > 0.0f;
+    EXPECT_EQ(on, preset == "robust") << preset;
+    if (preset != "robust") {
+      EXPECT_EQ(config.ddpg.smooth_temporal_weight + config.ddpg.smooth_spatial_weight, 0.0f);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace auvrl::learner
