@@ -82,8 +82,9 @@ void DdpgConfig::validate() const {
       {smooth_spatial_weight, "smooth_spatial_weight"},
       {smooth_spatial_sigma, "smooth_spatial_sigma"}};
   for (const auto& [value, key] : non_negative) {
-    if (!(value >= 0.0f) || !std::isfinite(value))
+    if (!(value >= 0.0f) || !std::isfinite(value)) {
       bad(std::string(key) + " must be finite and >= 0");
+    }
   }
   actor_spec(*this).validate();
   critic_spec(*this).validate();
