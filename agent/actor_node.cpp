@@ -12,6 +12,18 @@
 
 namespace auvrl::agent {
 
+// The report's condition bits are the randomisation's.
+namespace {
+constexpr bool same_bit(int wire, unsigned kind) { return static_cast<unsigned>(wire) == kind; }
+using Report = auvrl_lcm::episode_report_t;
+using Conditions = task::EpisodeConditions;
+static_assert(same_bit(Report::CONDITION_FAULT, Conditions::kFault) &&
+              same_bit(Report::CONDITION_CURRENT, Conditions::kCurrent) &&
+              same_bit(Report::CONDITION_VARYING_CURRENT, Conditions::kVaryingCurrent) &&
+              same_bit(Report::CONDITION_SENSOR_NOISE, Conditions::kSensorNoise) &&
+              same_bit(Report::CONDITION_MODEL, Conditions::kModel));
+}  // namespace
+
 using Clock = std::chrono::steady_clock;
 
 /// Acts with the newest policy the actor holds, checking for new weights every step so the
@@ -48,6 +60,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
              config_.seed * 0x9E3779B97F4A7C15ull + 1),
       goal_rng_(config_.seed),
       start_rng_(config_.seed * 0xBF58476D1CE4E5B9ull + 7),
+      conditions_rng_(config_.seed * 0xD6E8FEB86659FD93ull + 13),
       demonstration_rng_(config_.seed * 0x94D049BB133111EBull + 11),
       policy_(config_.task.state_dim(), config_.task.num_thrusters, config_.initial_beta_m) {
   config_.task.validate();
@@ -138,6 +151,10 @@ EpisodeSummary ActorNode::run_one_episode() {
   options.start.velocity_body_mps = start.velocity_body_mps;
   options.start.angular_rate_body_rad_s = start.angular_rate_body_rad_s;
   options.start.seed = config_.seed * 1000003ull + static_cast<std::uint64_t>(episode_id_);
+  // Drawn every episode (a fixed count), so its stream does not depend on the probabilities.
+  last_conditions_ =
+      task::sample_conditions(config_.task.randomise, config_.task.num_thrusters, conditions_rng_);
+  apply_conditions(last_conditions_, options.start);
   options.noise = &noise_;
   options.expert = config_.expert.get();
   // Drawn every episode, so the stream does not depend on the fraction's history.
@@ -220,6 +237,7 @@ void ActorNode::send_report(const EpisodeSummary& summary, const Eigen::Vector3d
   for (int i = 0; i < 3; ++i) report.goal_ned_m[i] = goal[i];
   report.thrust_energy = summary.thrust_energy;
   report.end_reason = static_cast<std::int8_t>(summary.end_reason);
+  report.conditions = static_cast<std::int32_t>(last_conditions_.kinds);
   transport::publish(transport_, channels::kEpisode, report);
 }
 

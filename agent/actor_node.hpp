@@ -97,6 +97,8 @@ class ActorNode {
   EpisodeSummary run_one_episode();
   /// Whether the last episode run was a demonstration.
   bool last_was_demonstration() const { return last_was_demonstration_; }
+  /// What the last episode's randomisation drew (task.randomise).
+  const task::EpisodeConditions& last_conditions() const { return last_conditions_; }
 
   /// The learner said training is over.
   bool training_done() const { return policy_.training_done(); }
@@ -121,8 +123,11 @@ class ActorNode {
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
   std::mt19937_64 start_rng_;  ///< its own stream: exploring starts leave the goals unchanged
+  /// Its own stream too: randomised episodes (task.randomise) leave goals and starts unchanged.
+  std::mt19937_64 conditions_rng_;
   std::mt19937_64 demonstration_rng_;
   bool last_was_demonstration_ = false;
+  task::EpisodeConditions last_conditions_;
   ActorCounters counters_;
   /// Waits (flow control) while the learner's backlog is above the configured limit.
   void wait_for_learner();

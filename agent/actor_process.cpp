@@ -41,19 +41,28 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
                         std::ostream& log) {
   double return_sum = 0.0;
   int successes = 0, window = 0;
+  int randomised = 0, randomised_successes = 0;  // episodes with task.randomise conditions
   while (!signals::stop_requested() && !node.training_done() &&
          (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
     const EpisodeSummary s = node.run_one_episode();
     if (node.last_was_demonstration()) continue;  // the window is the policy's
     return_sum += s.episode_return;
     successes += s.success ? 1 : 0;
+    if (node.last_conditions().kinds != 0) {
+      ++randomised;
+      randomised_successes += s.success ? 1 : 0;
+    }
     if (++window == report_every) {
       log << "auv_actor " << config.actor_id << ": episodes " << node.counters().episodes
           << ", policy v" << node.policy_version() << ", beta " << node.beta_m()
-          << " m, mean return " << return_sum / window << ", success " << successes << "/" << window
-          << "\n";
+          << " m, mean return " << return_sum / window << ", success " << successes << "/"
+          << window;
+      if (config.task.randomise.any()) {
+        log << " (randomised episodes " << randomised_successes << "/" << randomised << ")";
+      }
+      log << "\n";
       return_sum = 0.0;
-      successes = window = 0;
+      successes = window = randomised = randomised_successes = 0;
     }
   }
   const auto& c = node.counters();
@@ -74,7 +83,7 @@ void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions&
   log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << " "
       << describe(config.vehicle) << ", " << task::to_string(config.task.layout) << " state ("
       << config.task.state_dim() << "), " << task::to_string(config.task.reward) << " reward, seed "
-      << options.seed << "\n";
+      << options.seed << ", randomised episodes: " << task::describe(config.task.randomise) << "\n";
   run_actor_episodes(node, config, options.report_every, log);
 }
 

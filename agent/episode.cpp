@@ -105,7 +105,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
     const double next_distance = (goal - next->observation.position_ned_m).norm();
     const task::StepOutcome outcome = task::evaluate_step(
         task, distance, next_distance, task::is_flipped(task, next->observation.euler_rpy_rad),
-        action, options.beta_m, t);
+        action, options.beta_m, t, previous_action);
     task::build_state(task, next->observation, goal, action, next_state, next->thrust_realised_n);
 
     if (!task_ended) {

@@ -28,6 +28,24 @@ void expect_vehicle(const VehicleFacts& expected, const auvrl_lcm::vehicle_state
   }
 }
 
+void apply_conditions(const task::EpisodeConditions& c, EpisodeStart& start) {
+  start.thruster_efficiency = c.thruster_efficiency;
+  start.current_ned_mps = c.current_ned_mps;
+  start.current_varying_sigma_mps = c.varying_current_sigma_mps;
+  start.current_varying_time_constant_s = c.varying_current_time_constant_s;
+  start.current_varying_direction_rad = c.varying_current_direction_rad;
+  start.sensor_noise.position_sigma_m = c.noise_position_m;
+  start.sensor_noise.attitude_sigma_rad = c.noise_attitude_rad;
+  start.sensor_noise.linear_velocity_sigma_mps = c.noise_velocity_mps;
+  start.sensor_noise.angular_velocity_sigma_rad_s = c.noise_angular_rate_rad_s;
+  sim::ModelVariation& v = start.model_variation;
+  v.quadratic_damping_scale = c.quadratic_damping_scale;
+  v.added_mass_scale = c.added_mass_scale;
+  v.mass_scale = c.mass_scale;
+  v.thruster_lag_time_constant_s = c.thruster_lag_time_constant_s;
+  v.extra_buoyancy_n = c.extra_buoyancy_n;
+}
+
 namespace {
 
 class InProcessLink final : public VehicleLink {
@@ -39,7 +57,11 @@ class InProcessLink final : public VehicleLink {
     if (start.model_variation.is_identity()) {
       model_ = &nominal_;
     } else {
-      varied_ = sim::vary_model(nominal_, start.model_variation);
+      // Varied again only when the variation changes (a suite runs many episodes on one).
+      if (!varied_ || start.model_variation != variation_) {
+        varied_ = sim::vary_model(nominal_, start.model_variation);
+        variation_ = start.model_variation;
+      }
       model_ = &*varied_;
     }
     sim::ResetSettings settings;
@@ -101,6 +123,7 @@ class InProcessLink final : public VehicleLink {
 
   const sim::VehicleModel& nominal_;
   std::optional<sim::VehicleModel> varied_;  ///< this episode's vehicle, when it is varied
+  sim::ModelVariation variation_;            ///< what varied_ was built with
   const sim::VehicleModel* model_;           ///< nominal_ or varied_
   std::optional<sim::VehicleState> state_;
   sim::ThrusterVector command_;
@@ -134,9 +157,14 @@ class LockstepLink final : public VehicleLink {
     msg.current_gm_sigma_mps = start.current_varying_sigma_mps;
     msg.current_gm_time_constant_s = start.current_varying_time_constant_s;
     msg.current_gm_direction_rad = start.current_varying_direction_rad;
-    if (!start.model_variation.is_identity()) {
-      throw std::invalid_argument(
-          "the lockstep link cannot vary auv_sim's vehicle model (EpisodeStart::model_variation)");
+    const sim::ModelVariation& variation = start.model_variation;
+    msg.model_varied = !variation.is_identity();
+    if (msg.model_varied) {
+      msg.model_quadratic_damping_scale = variation.quadratic_damping_scale;
+      msg.model_added_mass_scale = variation.added_mass_scale;
+      msg.model_mass_scale = variation.mass_scale;
+      msg.model_thruster_lag_time_constant_s = variation.thruster_lag_time_constant_s;
+      msg.model_extra_buoyancy_n = variation.extra_buoyancy_n;
     }
     msg.seed = static_cast<std::int64_t>(start.seed);
     const std::optional<auvrl_lcm::vehicle_state_t> reply = client_.reset(msg);

@@ -52,6 +52,10 @@ struct EpisodeStart {
   std::uint64_t seed = 1;
 };
 
+/// Puts what a training episode's randomisation drew (task::sample_conditions) into its start:
+/// thruster efficiencies, currents, sensor noise and model variation.
+void apply_conditions(const task::EpisodeConditions& conditions, EpisodeStart& start);
+
 /// A vehicle an episode can reset and command. Returns nothing when the vehicle did not answer.
 class VehicleLink {
  public:

@@ -5,7 +5,7 @@
 // (AUV dims 23/6, one thread) for DDPG and TD3 and the same with pendulum dims (state 3,
 // action 1), RLtools' published cases (batch 100 at 256-256 and 400-400), and the fast preset's
 // learner without and with the PID imitation term alternated three times (the machine is
-// shared), with the ratio of their rates.
+// shared), with the ratio of their rates, and the same for the smoothness terms (CAPS, both on).
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -32,25 +32,38 @@ void run_case(benchmark::State& state, BenchCase c) {
   }
 }
 
-/// The imitation term's cost: the same case without and with it, interleaved so that both see
-/// the same load; the ratio of the sums is what to compare across machines.
-void imitation_ratio(benchmark::State& state) {
+/// A term's cost: the case without and with it, interleaved so that both see the same load;
+/// the ratio of the sums is what to compare across machines.
+void term_ratio(benchmark::State& state, BenchCase without, BenchCase with) {
   for (auto _ : state) {
-    double plain_updates = 0, plain_s = 0, imitation_updates = 0, imitation_s = 0;
+    double plain_updates = 0, plain_s = 0, term_updates = 0, term_s = 0;
     for (int round = 0; round < 3; ++round) {
-      for (float weight : {0.0f, 0.4f}) {
-        BenchCase c = auvrl::learner::fast_preset_bench_case(weight);
+      for (bool on : {false, true}) {
+        BenchCase c = on ? with : without;
         c.seconds = kSecondsPerCase;
         const BenchResult r = auvrl::learner::run_update_benchmark(c);
-        (weight > 0.0f ? imitation_updates : plain_updates) += static_cast<double>(r.updates);
-        (weight > 0.0f ? imitation_s : plain_s) += r.seconds;
+        (on ? term_updates : plain_updates) += static_cast<double>(r.updates);
+        (on ? term_s : plain_s) += r.seconds;
       }
     }
-    state.SetIterationTime(plain_s + imitation_s);
+    state.SetIterationTime(plain_s + term_s);
     state.counters["without_updates_per_s"] = plain_updates / plain_s;
-    state.counters["with_updates_per_s"] = imitation_updates / imitation_s;
-    state.counters["ratio"] = (imitation_updates / imitation_s) / (plain_updates / plain_s);
+    state.counters["with_updates_per_s"] = term_updates / term_s;
+    state.counters["ratio"] = (term_updates / term_s) / (plain_updates / plain_s);
   }
+}
+
+/// The imitation term's cost in the fast preset's learner.
+void imitation_ratio(benchmark::State& state) {
+  term_ratio(state, auvrl::learner::fast_preset_bench_case(0.0f),
+             auvrl::learner::fast_preset_bench_case(0.4f));
+}
+
+/// The smoothness terms' cost (temporal and spatial) in the fast preset's learner (imitation on).
+void smoothness_ratio(benchmark::State& state) {
+  BenchCase with = auvrl::learner::fast_preset_bench_case(0.4f);
+  with.smooth_temporal_weight = with.smooth_spatial_weight = 0.1f;
+  term_ratio(state, auvrl::learner::fast_preset_bench_case(0.4f), with);
 }
 
 std::string case_name(const BenchCase& c) {
@@ -92,6 +105,10 @@ void register_all() {
     }
   }
   benchmark::RegisterBenchmark("fast_preset/imitation_ratio", imitation_ratio)
+      ->Iterations(1)
+      ->UseManualTime()
+      ->Unit(benchmark::kSecond);
+  benchmark::RegisterBenchmark("fast_preset/smoothness_ratio", smoothness_ratio)
       ->Iterations(1)
       ->UseManualTime()
       ->Unit(benchmark::kSecond);

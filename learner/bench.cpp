@@ -68,6 +68,8 @@ BenchResult run_update_benchmark(const BenchCase& c) {
   config.critic_action_layer = c.algo == Algo::kTd3 ? 0 : 1;
   config.batch_size = c.batch;
   config.expert_weight = c.expert_weight;
+  config.smooth_temporal_weight = c.smooth_temporal_weight;
+  config.smooth_spatial_weight = c.smooth_spatial_weight;
   Ddpg learner(config);
   nn::Rng rng(12345);
   ReplayBuffer replay(c.state_dim, c.action_dim, kReplaySize);
@@ -142,6 +144,10 @@ std::string format_bench_line(const BenchResult& r) {
     os << " state_dim=" << r.config.state_dim << " action_dim=" << r.config.action_dim;
   }
   if (r.config.expert_weight > 0.0f) os << " expert_weight=" << r.config.expert_weight;
+  if (r.config.smooth_temporal_weight > 0.0f || r.config.smooth_spatial_weight > 0.0f) {
+    os << " smooth_temporal_weight=" << r.config.smooth_temporal_weight
+       << " smooth_spatial_weight=" << r.config.smooth_spatial_weight;
+  }
   return os.str();
 }
 

@@ -27,6 +27,10 @@ struct BenchCase {
   /// Q-filtered imitation (DdpgConfig::expert_weight): > 0 labels every transition with an
   /// expert action and adds the imitation term (and its Q filter) to each actor step.
   float expert_weight = 0.0f;
+  /// Smoothness terms (DdpgConfig::smooth_temporal_weight, smooth_spatial_weight): > 0 adds the
+  /// next states and perturbed states to each actor step's forward and backward pass.
+  float smooth_temporal_weight = 0.0f;
+  float smooth_spatial_weight = 0.0f;
 };
 
 /// What a case measured.
@@ -57,8 +61,9 @@ std::vector<BenchCase> standard_bench_cases(Algo algo);
 BenchCase fast_preset_bench_case(float expert_weight);
 
 /// "algo=ddpg hidden=256-256 batch=256 threads=1 updates_per_s=N"; for dims other than the AUV
-/// task's (23, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken, and
-/// " expert_weight=W" with imitation.
+/// task's (23, 6), " state_dim=S action_dim=A" is appended so the line cannot be mistaken,
+/// " expert_weight=W" with imitation and " smooth_temporal_weight=T smooth_spatial_weight=S"
+/// with the smoothness terms.
 std::string format_bench_line(const BenchResult& r);
 /// Writes format_bench_line(r) and a newline.
 void print_bench_line(std::ostream& os, const BenchResult& r);

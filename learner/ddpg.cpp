@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "common/nn/serialize.hpp"
@@ -33,6 +34,12 @@ nn::MlpSpec actor_spec(const DdpgConfig& c) {
 
 nn::MlpSpec critic_spec(const DdpgConfig& c) {
   return nn::MlpSpec::critic(c.state_dim, c.action_dim, c.critic_hidden, c.critic_action_layer);
+}
+
+/// Columns of the actor's forward pass per minibatch sample: the state, and the next state and
+/// a perturbed state where the smoothness terms ask for them.
+int actor_columns(const DdpgConfig& c) {
+  return 1 + (c.smooth_temporal_weight > 0.0f ? 1 : 0) + (c.smooth_spatial_weight > 0.0f ? 1 : 0);
 }
 
 nn::AdamConfig adam_config(float lr, float weight_decay, float clip) {
@@ -70,6 +77,15 @@ void DdpgConfig::validate() const {
       !std::isfinite(expert_weight_half_life_updates)) {
     bad("expert_weight_half_life_updates must be finite and >= 0");
   }
+  const std::pair<float, const char*> non_negative[] = {
+      {smooth_temporal_weight, "smooth_temporal_weight"},
+      {smooth_spatial_weight, "smooth_spatial_weight"},
+      {smooth_spatial_sigma, "smooth_spatial_sigma"}};
+  for (const auto& [value, key] : non_negative) {
+    if (!(value >= 0.0f) || !std::isfinite(value)) {
+      bad(std::string(key) + " must be finite and >= 0");
+    }
+  }
   actor_spec(*this).validate();
   critic_spec(*this).validate();
 }
@@ -77,8 +93,8 @@ void DdpgConfig::validate() const {
 Ddpg::Ddpg(const DdpgConfig& config)
     : config_(validated(config)),
       rng_(config.seed),
-      actor_(actor_spec(config), config.batch_size),
-      actor_target_(actor_),
+      actor_(actor_spec(config), config.batch_size * actor_columns(config)),
+      actor_target_(actor_spec(config), config.batch_size),
       actor_opt_(
           adam_config(config.actor_lr, config.actor_weight_decay, config.actor_grad_clip_norm),
           actor_),
@@ -89,7 +105,10 @@ Ddpg::Ddpg(const DdpgConfig& config)
       y_(nn::Matrix::Zero(1, config.batch_size)),
       dq_(nn::Matrix::Zero(1, config.batch_size)),
       q_expert_(nn::Matrix::Zero(1, config.batch_size)),
-      dmu_(nn::Matrix::Zero(config.action_dim, config.batch_size)) {
+      dmu_(nn::Matrix::Zero(config.action_dim, config.batch_size * actor_columns(config))),
+      actor_input_(nn::Matrix::Zero(
+          config.state_dim,
+          actor_columns(config) > 1 ? config.batch_size * actor_columns(config) : 0)) {
   // Line 1: initialise mu and Q (Lillicrap's scheme), from the seed.
   actor_.init_lillicrap(rng_);
   const int num_critics = config_.algo == Algo::kTd3 ? 2 : 1;
@@ -174,6 +193,8 @@ UpdateStats Ddpg::update(const Batch& b) {
   }
   stats.actor_loss = last_actor_loss_;
   stats.expert_share = last_expert_share_;
+  stats.smooth_temporal = last_smooth_temporal_;
+  stats.smooth_spatial = last_smooth_spatial_;
   return stats;
 }
 
@@ -182,6 +203,8 @@ UpdateStats Ddpg::update(const Batch& b) {
 // dQ/du comes from the (just updated) critic's backward pass to its action input, then runs
 // back through the actor. With expert_weight, the Q-filtered imitation term (see DdpgConfig)
 // adds c * m_i * (mu(x_i) - a^E_i) to dJ/dmu, c = 2 * weight * mean|Q| / (N * action_dim).
+// With the smoothness terms, one forward and one backward pass of the actor take the next and
+// the perturbed states as extra columns (add_smoothness_gradients).
 void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
   const Eigen::Index n = b.size;
   const auto x = b.state.leftCols(n);
@@ -191,18 +214,22 @@ void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
     // Before the policy's own forward pass: the backward pass needs that one's activations.
     q_expert = critics_[0].forward(x, b.expert_action.leftCols(n));
   }
-  const auto mu = actor_.forward(x);
+  const Eigen::Index columns = smoothing() ? stack_actor_inputs(b) : n;
+  const auto mu_all =
+      smoothing() ? actor_.forward(actor_input_.leftCols(columns)) : actor_.forward(x);
+  const auto mu = mu_all.leftCols(n);
   const auto q = critics_[0].forward(x, mu);
   last_actor_loss_ = -q.mean();
   auto dq = dq_.leftCols(n);
   dq.setConstant(-1.0f / static_cast<float>(n));
   critics_[0].backward(dq, nn::GradRequest{false, false, true});
-  auto dmu = dmu_.leftCols(n);
-  dmu = critics_[0].extra_input_grad();
+  auto dmu = dmu_.leftCols(columns);
+  dmu.leftCols(n) = critics_[0].extra_input_grad();
+  const float q_scale = q.cwiseAbs().mean();
+  if (smoothing()) add_smoothness_gradients(n, q_scale);
   last_expert_share_ = 0.0f;
   if (imitate) {
-    const float c =
-        2.0f * expert_weight() * q.cwiseAbs().mean() / static_cast<float>(n * config_.action_dim);
+    const float c = 2.0f * expert_weight() * q_scale / static_cast<float>(n * config_.action_dim);
     int applied = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       const bool use =
@@ -217,6 +244,56 @@ void Ddpg::actor_step(const Batch& b, UpdateStats& stats) {
   stats.actor_grad_norm = actor_opt_.step(actor_);
   stats.actor_updated = true;
   ++actor_updates_;
+}
+
+Eigen::Index Ddpg::stack_actor_inputs(const Batch& b) {
+  const Eigen::Index n = b.size;
+  Eigen::Index columns = n;
+  actor_input_.leftCols(n) = b.state.leftCols(n);
+  if (config_.smooth_temporal_weight > 0.0f) {
+    actor_input_.middleCols(columns, n) = b.next_state.leftCols(n);
+    columns += n;
+  }
+  perturbed_count_ = 0;
+  if (config_.smooth_spatial_weight > 0.0f) {
+    auto perturbed = actor_input_.middleCols(columns, n);
+    nn::fill_standard_normal(rng_, perturbed);
+    perturbed = b.state.leftCols(n) + config_.smooth_spatial_sigma * perturbed;
+    perturbed_begin_ = columns;
+    perturbed_count_ = n;
+    columns += n;
+  }
+  return columns;
+}
+
+// CAPS: a term w * q_scale * 1/N sum_i mean_j (mu_j(x_i) - mu_j(z_i))^2, z_i the next or the
+// perturbed state, adds c * (mu(x_i) - mu(z_i)) to dJ/dmu(x_i) and its negative to dJ/dmu(z_i),
+// c = 2 * w * q_scale / (N * action_dim).
+void Ddpg::add_smoothness_gradients(Eigen::Index n, float q_scale) {
+  const auto mu_all = actor_.output();
+  const auto mu = mu_all.leftCols(n);
+  const float per_entry = 1.0f / static_cast<float>(n * config_.action_dim);
+  Eigen::Index column = n;
+  const auto term = [&](float weight, float& value) {
+    const auto other = mu_all.middleCols(column, n);
+    value = (mu - other).squaredNorm() * per_entry;
+    const float c = 2.0f * weight * q_scale * per_entry;
+    dmu_.leftCols(n) += c * (mu - other);
+    dmu_.middleCols(column, n) = -c * (mu - other);
+    column += n;
+  };
+  last_smooth_temporal_ = last_smooth_spatial_ = 0.0f;
+  if (config_.smooth_temporal_weight > 0.0f) {
+    term(config_.smooth_temporal_weight, last_smooth_temporal_);
+  }
+  if (config_.smooth_spatial_weight > 0.0f) {
+    term(config_.smooth_spatial_weight, last_smooth_spatial_);
+  }
+}
+
+Eigen::Block<const nn::Matrix> Ddpg::last_perturbed_states() const {
+  return Eigen::Block<const nn::Matrix>(actor_input_, 0, perturbed_begin_, actor_input_.rows(),
+                                        perturbed_count_);
 }
 
 float Ddpg::expert_weight() const {

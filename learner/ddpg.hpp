@@ -81,6 +81,21 @@ struct DdpgConfig {
   /// filter); false: wherever there is a label.
   bool expert_q_filter = true;
 
+  /// Smooth control, CAPS (Mysore et al. 2021, "Regularizing Action Policies for Smooth Control
+  /// with Reinforcement Learning"): the actor's loss gains a temporal term
+  ///   smooth_temporal_weight * mean|Q| * 1/N sum_i mean_j (mu_j(x_i) - mu_j(x'_i))^2,
+  /// x'_i the transition's next state (one step later, commands alike), and a spatial term
+  ///   smooth_spatial_weight * mean|Q| * 1/N sum_i mean_j (mu_j(x_i) - mu_j(x_i + e_i))^2,
+  /// e_i ~ N(0, smooth_spatial_sigma^2 I) on the network's input (similar states, similar
+  /// commands), with gradients through both policy outputs of each term. mean|Q| (not
+  /// differentiated), as for expert_weight, makes the weights independent of the reward's scale
+  /// (CAPS weighs its terms against raw Q). 0: off.
+  float smooth_temporal_weight = 0.0f;
+  float smooth_spatial_weight = 0.0f;
+  /// Standard deviation of the spatial term's perturbation, in the network's input units (the
+  /// task's scaled observation).
+  float smooth_spatial_sigma = 0.05f;
+
   std::uint64_t seed = 1;  ///< initial weights, minibatch sampling and TD3 noise
 
   /// Throws std::invalid_argument naming the first unusable value.
@@ -101,6 +116,10 @@ struct UpdateStats {
   /// Share of the actor step's minibatch the imitation term applied to (labelled and, with
   /// the Q filter, rated better than the policy); 0 without expert_weight.
   float expert_share = 0;
+  /// The actor step's 1/N sum_i mean_j (mu_j(x_i) - mu_j(x'_i))^2 and the same for the
+  /// perturbed states, before the step; 0 where the term is off.
+  float smooth_temporal = 0;
+  float smooth_spatial = 0;
 };
 
 /// The learner's networks, optimisers and update rule. Construction is Algorithm 1's lines 1-2
@@ -134,6 +153,9 @@ class Ddpg {
   std::int64_t updates() const { return updates_; }
   /// Actor steps done (fewer than updates() with TD3's delay).
   std::int64_t actor_updates() const { return actor_updates_; }
+  /// The perturbed states x_i + e_i of the last actor step's spatial smoothness term
+  /// (state_dim x N; empty when the term is off), for tests.
+  Eigen::Block<const nn::Matrix> last_perturbed_states() const;
 
   /// Writes the full learning state (networks, targets, Adam moments, step counters, random
   /// generator) as one self-checking record:
@@ -153,6 +175,15 @@ class Ddpg {
 
  private:
   void actor_step(const Batch& b, UpdateStats& stats);
+  /// The columns of the actor's forward pass: the minibatch's states, then the next states
+  /// (temporal term), then the perturbed states (spatial term); returns how many.
+  Eigen::Index stack_actor_inputs(const Batch& b);
+  /// Adds the smoothness terms' gradients (CAPS) to dmu_ (all stacked columns), scaled by
+  /// q_scale = mean|Q|, and records the terms' values.
+  void add_smoothness_gradients(Eigen::Index n, float q_scale);
+  bool smoothing() const {
+    return config_.smooth_temporal_weight > 0.0f || config_.smooth_spatial_weight > 0.0f;
+  }
 
   DdpgConfig config_;
   nn::Rng rng_;
@@ -173,8 +204,11 @@ class Ddpg {
   nn::Matrix y_;            // targets y_i (1 x m)
   nn::Matrix dq_;           // dL/dQ (1 x m)
   nn::Matrix q_expert_;     // Q(x_i, a^E_i) (1 x m)
-  nn::Matrix dmu_;          // dL/dmu (action_dim x m)
+  nn::Matrix dmu_;          // dL/dmu (action_dim x m, or x up to 3m with smoothness terms)
+  nn::Matrix actor_input_;  // smoothness: [x_i | x'_i | x_i + e_i] (state_dim x up to 3m)
+  Eigen::Index perturbed_begin_ = 0, perturbed_count_ = 0;  // columns of x_i + e_i in it
   float last_expert_share_ = 0;
+  float last_smooth_temporal_ = 0, last_smooth_spatial_ = 0;
 };
 
 }  // namespace auvrl::learner

@@ -37,7 +37,7 @@ void HindsightRelabeler::rebuild(const ReplayBuffer& replay) {
 void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::Rng& rng,
                                  Batch& batch) const {
   task::StateVector state, next_state;
-  task::ActionVector action;
+  task::ActionVector action, previous_action;
   for (int i = 0; i < batch.size; ++i) {
     if (nn::uniform01(rng) >= relabel_probability_) continue;
     const std::size_t slot = batch.slot[static_cast<std::size_t>(i)];
@@ -75,9 +75,11 @@ void HindsightRelabeler::relabel(const ReplayBuffer& replay, double beta_m, nn::
 
     task::relabel_state(task_, old_goal, new_goal, state);
     task::relabel_state(task_, old_goal, new_goal, next_state);
+    // The command change price: u_t-1 is in the state (relabelling leaves it).
+    task::previous_action_from_state(task_, state, previous_action);
     const task::StepOutcome outcome =
         task::evaluate_step(task_, (new_goal - before).norm(), (new_goal - achieved).norm(),
-                            flipped, action, beta_m, static_cast<int>(step) + 1);
+                            flipped, action, beta_m, static_cast<int>(step) + 1, previous_action);
     batch.state.col(i) = state;
     batch.next_state.col(i) = next_state;
     batch.reward(0, i) = static_cast<float>(outcome.reward);

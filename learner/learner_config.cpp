@@ -48,6 +48,15 @@ config::Table<DdpgConfig> make_ddpg_table() {
           "imitate only where the critic prefers the expert's action");
   t.field("expert_weight_half_life_updates", &C::expert_weight_half_life_updates,
           "updates, 0: constant", "the expert weight halves every this many updates");
+  t.field("smooth_temporal_weight", &C::smooth_temporal_weight, "0: off",
+          "CAPS: weight (x mean|Q|) of the price of commands changing from x to the next state")
+      .range(0.0);
+  t.field("smooth_spatial_weight", &C::smooth_spatial_weight, "0: off",
+          "CAPS: weight (x mean|Q|) of the price of commands changing under a perturbed state")
+      .range(0.0);
+  t.field("smooth_spatial_sigma", &C::smooth_spatial_sigma, "state units",
+          "CAPS: standard deviation of that perturbation of the network's input")
+      .range(0.0);
   t.field("seed", &C::seed, "", "seed of the networks, sampling and TD3 noise");
   return t;
 }

@@ -227,6 +227,8 @@ void LearnerNode::run_updates() {
     interval_mean_q_ += stats.mean_q;
     if (stats.actor_updated) {
       interval_expert_share_ += stats.expert_share;
+      interval_smooth_temporal_ += stats.smooth_temporal;
+      interval_smooth_spatial_ += stats.smooth_spatial;
       ++interval_actor_updates_;
     }
     maybe_publish_weights();
@@ -305,12 +307,15 @@ void LearnerNode::publish_stats() {
       s.dropped_dims + s.dropped_non_finite + s.dropped_unknown_actor + decode_stats_.failed;
   s.batches_lost = counters_.batches_lost;
   s.checkpoints_written = counters_.checkpoints_written;
-  s.expert_share = interval_actor_updates_ > 0
-                       ? interval_expert_share_ / static_cast<double>(interval_actor_updates_)
-                       : 0.0;
+  const double per_actor_step =
+      interval_actor_updates_ > 0 ? 1.0 / static_cast<double>(interval_actor_updates_) : 0.0;
+  s.expert_share = interval_expert_share_ * per_actor_step;
+  s.smooth_temporal = interval_smooth_temporal_ * per_actor_step;
+  s.smooth_spatial = interval_smooth_spatial_ * per_actor_step;
   transport::publish(transport_, channels::kLearnerStats, s);
   interval_updates_ = interval_transitions_ = 0;
   interval_critic_loss_ = interval_actor_loss_ = interval_mean_q_ = interval_expert_share_ = 0.0;
+  interval_smooth_temporal_ = interval_smooth_spatial_ = 0.0;
   interval_actor_updates_ = 0;
   interval_start_ = now;
   next_stats_ = now + seconds(config_.stats_period_s);

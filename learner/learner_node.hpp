@@ -159,7 +159,9 @@ class LearnerNode {
   double interval_critic_loss_ = 0.0;
   double interval_actor_loss_ = 0.0;
   double interval_mean_q_ = 0.0;
-  double interval_expert_share_ = 0.0;  ///< summed over the interval's actor steps
+  double interval_expert_share_ = 0.0;     ///< summed over the interval's actor steps
+  double interval_smooth_temporal_ = 0.0;  ///< summed over the interval's actor steps
+  double interval_smooth_spatial_ = 0.0;   ///< summed over the interval's actor steps
   std::int64_t interval_actor_updates_ = 0;
   std::chrono::steady_clock::time_point interval_start_;
 };

@@ -45,6 +45,8 @@ int run_learner_bench(const LearnerNodeConfig& config, const LearnerProcessOptio
   for (auto& c : cases) {
     c.threads = options.threads;
     c.seconds = options.bench_seconds;
+    c.smooth_temporal_weight = config.ddpg.smooth_temporal_weight;
+    c.smooth_spatial_weight = config.ddpg.smooth_spatial_weight;
     print_bench_line(out, run_update_benchmark(c));
   }
   return 0;

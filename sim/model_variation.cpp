@@ -23,6 +23,13 @@ bool ModelVariation::is_identity() const {
          thruster_lag_time_constant_s < 0 && extra_buoyancy_n == 0.0;
 }
 
+bool ModelVariation::operator==(const ModelVariation& o) const {
+  return quadratic_damping_scale == o.quadratic_damping_scale &&
+         added_mass_scale == o.added_mass_scale && mass_scale == o.mass_scale &&
+         thruster_lag_time_constant_s == o.thruster_lag_time_constant_s &&
+         extra_buoyancy_n == o.extra_buoyancy_n;
+}
+
 VehicleModel vary_model(const VehicleModel& nominal, const ModelVariation& v) {
   require_scale(v.quadratic_damping_scale, "quadratic_damping_scale");
   require_scale(v.added_mass_scale, "added_mass_scale");

@@ -20,6 +20,9 @@ struct ModelVariation {
 
   /// True when it changes nothing.
   bool is_identity() const;
+  /// Field by field (a simulator varies its model again only when the variation changes).
+  bool operator==(const ModelVariation& o) const;
+  bool operator!=(const ModelVariation& o) const { return !(*this == o); }
 };
 
 /// The nominal model with the variation applied, its derived matrices recomputed (its name,

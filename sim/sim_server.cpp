@@ -86,6 +86,28 @@ std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, i
   return "";
 }
 
+std::string model_variation_from_message(const auvrl_lcm::vehicle_reset_t& msg,
+                                         ModelVariation& out) {
+  out = ModelVariation{};
+  if (!msg.model_varied) return "";
+  const double values[] = {msg.model_quadratic_damping_scale, msg.model_added_mass_scale,
+                           msg.model_mass_scale, msg.model_thruster_lag_time_constant_s,
+                           msg.model_extra_buoyancy_n};
+  if (!all_finite(values, std::size(values))) return "non-finite model variation";
+  if (!(msg.model_quadratic_damping_scale > 0)) {
+    return "vehicle_reset_t.model_quadratic_damping_scale must be > 0";
+  }
+  if (!(msg.model_added_mass_scale > 0))
+    return "vehicle_reset_t.model_added_mass_scale must be > 0";
+  if (!(msg.model_mass_scale > 0)) return "vehicle_reset_t.model_mass_scale must be > 0";
+  out.quadratic_damping_scale = msg.model_quadratic_damping_scale;
+  out.added_mass_scale = msg.model_added_mass_scale;
+  out.mass_scale = msg.model_mass_scale;
+  out.thruster_lag_time_constant_s = msg.model_thruster_lag_time_constant_s;
+  out.extra_buoyancy_n = msg.model_extra_buoyancy_n;
+  return "";
+}
+
 void state_message_from_measurement(const VehicleModel& model, const Measurement& measurement,
                                     const VehicleState& state, int vehicle_id, std::int64_t seq,
                                     auvrl_lcm::vehicle_state_t& out) {
@@ -228,7 +250,9 @@ void SimServer::on_reset(const std::string& channel, const auvrl_lcm::vehicle_re
   Vehicle* vehicle = addressed_vehicle(channel, msg.vehicle_id);
   if (vehicle == nullptr) return;
   ResetSettings settings;
-  const std::string problem = reset_settings_from_message(msg, model_.num_thrusters(), settings);
+  ModelVariation variation;
+  std::string problem = reset_settings_from_message(msg, model_.num_thrusters(), settings);
+  if (problem.empty()) problem = model_variation_from_message(msg, variation);
   if (!problem.empty()) {
     if (problem.rfind("non-finite", 0) == 0) {
       ++counters_.dropped_non_finite;
@@ -239,12 +263,28 @@ void SimServer::on_reset(const std::string& channel, const auvrl_lcm::vehicle_re
     }
     return;
   }
-  vehicle->state = make_state(model_, settings);
+  if (!set_variation(*vehicle, variation)) return;
+  vehicle->state = make_state(model_of(*vehicle), settings);
   vehicle->held_command_n.setZero();
   vehicle->active = true;
   vehicle->last_seq = msg.seq;
   ++counters_.resets_total;
   publish_state(msg.vehicle_id, *vehicle);
+}
+
+bool SimServer::set_variation(Vehicle& vehicle, const ModelVariation& variation) {
+  if (variation.is_identity()) {
+    vehicle.varied_model.reset();
+  } else if (!vehicle.varied_model || variation != vehicle.variation) {
+    try {
+      vehicle.varied_model = vary_model(model_, variation);
+    } catch (const std::invalid_argument&) {
+      ++counters_.dropped_out_of_range;  // a variation the model cannot take
+      return false;
+    }
+  }
+  vehicle.variation = variation;
+  return true;
 }
 
 void SimServer::on_fault(const std::string& channel, const auvrl_lcm::thruster_fault_t& msg) {
@@ -257,7 +297,7 @@ void SimServer::on_fault(const std::string& channel, const auvrl_lcm::thruster_f
     return;
   }
   set_thruster_efficiency(
-      model_, vehicle->state,
+      model_of(*vehicle), vehicle->state,
       Eigen::Map<const Eigen::VectorXd>(msg.thruster_efficiency.data(), msg.num_thrusters));
   ++counters_.faults_total;
 }
@@ -282,15 +322,16 @@ void SimServer::on_current(const std::string& channel, const auvrl_lcm::water_cu
 
 void SimServer::step_vehicle(int /*id*/, Vehicle& vehicle, const ThrusterVector& command_n) {
   const bool was_ok = vehicle.state.status == StateStatus::kOk;
-  step(model_, vehicle.state, command_n);
+  step(model_of(vehicle), vehicle.state, command_n);
   ++counters_.steps_total;
   ++rate_window_steps_;
   if (was_ok && vehicle.state.status != StateStatus::kOk) ++counters_.blow_ups_total;
 }
 
 void SimServer::publish_state(int id, Vehicle& vehicle) {
-  const Measurement measurement = measure(model_, vehicle.state);
-  state_message_from_measurement(model_, measurement, vehicle.state, id, vehicle.last_seq,
+  const VehicleModel& model = model_of(vehicle);
+  const Measurement measurement = measure(model, vehicle.state);
+  state_message_from_measurement(model, measurement, vehicle.state, id, vehicle.last_seq,
                                  state_msg_);
   const int size = state_msg_.getEncodedSize();
   vehicle.last_state_bytes.resize(static_cast<std::size_t>(size));

@@ -11,11 +11,13 @@
 #include <auvrl_lcm/vehicle_state_t.hpp>
 #include <auvrl_lcm/water_current_t.hpp>
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/transport.hpp"
 #include "sim/dynamics.hpp"
+#include "sim/model_variation.hpp"
 
 namespace auvrl::sim {
 
@@ -53,13 +55,21 @@ struct SimServerCounters {
 std::string reset_settings_from_message(const auvrl_lcm::vehicle_reset_t& msg, int num_thrusters,
                                         ResetSettings& out);
 
+/// The model variation a reset message asks for (the identity when model_varied is false);
+/// returns an empty string if usable, else what is wrong, naming the field: "non-finite ..." for
+/// NaN or inf, else a value out of range (a scale not > 0).
+std::string model_variation_from_message(const auvrl_lcm::vehicle_reset_t& msg,
+                                         ModelVariation& out);
+
 /// Fills a state message from a measurement of vehicle id of `model`, answering sequence number
 /// seq; the message names the vehicle (name, file CRC-32, thruster count).
 void state_message_from_measurement(const VehicleModel& model, const Measurement& measurement,
                                     const VehicleState& state, int vehicle_id, std::int64_t seq,
                                     auvrl_lcm::vehicle_state_t& out);
 
-/// Serves the vehicles of one model over a transport.
+/// Serves the vehicles of one model over a transport. A reset may vary a vehicle's model
+/// (vehicle_reset_t.model_varied): that vehicle then steps and reports with its own varied copy
+/// until a reset says otherwise; the copy is built only when the variation changes.
 class SimServer {
  public:
   /// Lockstep traffic (commands, resets, faults, states) on `transport`; the heartbeat on
@@ -98,7 +108,17 @@ class SimServer {
     std::int64_t last_seq = 0;
     std::vector<std::uint8_t> last_state_bytes;  ///< re-sent when a command is repeated
     std::string state_channel;                   ///< SIM_STATE_<id>, built once
+    ModelVariation variation;                    ///< of the last reset
+    std::optional<VehicleModel> varied_model;    ///< the file's model with it; none: identity
   };
+
+  /// The model a vehicle runs: its varied copy, or the file's.
+  const VehicleModel& model_of(const Vehicle& vehicle) const {
+    return vehicle.varied_model ? *vehicle.varied_model : model_;
+  }
+  /// Makes the vehicle's model the file's with `variation` (varied again only if it changed);
+  /// false (counted) if vary_model refuses it, the vehicle unchanged then.
+  bool set_variation(Vehicle& vehicle, const ModelVariation& variation);
 
   void on_command(const std::string& channel, const auvrl_lcm::thruster_cmd_t& msg);
   void on_reset(const std::string& channel, const auvrl_lcm::vehicle_reset_t& msg);

@@ -73,6 +73,9 @@ void TaskConfig::validate() const {
                    hold_reward_per_step, distance_weight, precision_reward, start_yaw_rad}) {
     if (!std::isfinite(v)) throw std::invalid_argument("task: a reward constant is not finite");
   }
+  if (!(command_change_weight >= 0) || !std::isfinite(command_change_weight)) {
+    throw std::invalid_argument("task.command_change_weight must be finite and >= 0");
+  }
   if (!(random_start_fraction >= 0 && random_start_fraction <= 1)) {
     throw std::invalid_argument("task.random_start_fraction must be in [0, 1]");
   }
@@ -91,6 +94,7 @@ void TaskConfig::validate() const {
   }
   spread(start_velocity_max_body_mps, 5.0, "start_velocity_max_body_mps");
   spread(start_rate_max_body_rad_s, 2.0, "start_rate_max_body_rad_s");
+  randomise.validate();
   if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
       !goal_max_ned_m.allFinite() || (goal_max_ned_m - goal_min_ned_m).minCoeff() < 0) {
     throw std::invalid_argument("task: goal region must be finite with min <= max");
@@ -194,12 +198,31 @@ double thrust_cost(const TaskConfig& c, const ActionVector& action) {
          static_cast<double>(std::max<Eigen::Index>(1, action.size()));
 }
 
+double command_change_cost(const TaskConfig& c, const ActionVector& action,
+                           const ActionVector& previous) {
+  if (c.command_change_weight == 0.0 || previous.size() == 0) return 0.0;
+  if (previous.size() != action.size()) {
+    throw std::invalid_argument("command_change_cost: the previous action has " +
+                                std::to_string(previous.size()) + " entries, the action " +
+                                std::to_string(action.size()));
+  }
+  return c.command_change_weight * static_cast<double>((action - previous).squaredNorm()) /
+         static_cast<double>(std::max<Eigen::Index>(1, action.size()));
+}
+
+void previous_action_from_state(const TaskConfig& c, const Eigen::Ref<const StateVector>& state,
+                                ActionVector& out) {
+  const int first = c.layout == StateLayout::kPaper ? kPaperAction : kExtAction;
+  out = state.segment(first, c.num_thrusters);
+}
+
 bool is_flipped(const TaskConfig& c, const Eigen::Vector3d& euler) {
   return std::abs(euler[0]) > c.flip_angle_rad || std::abs(euler[1]) > c.flip_angle_rad;
 }
 
 StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, bool flipped,
-                          const ActionVector& action, double beta_m, int steps_taken) {
+                          const ActionVector& action, double beta_m, int steps_taken,
+                          const ActionVector& previous_action) {
   StepOutcome out;
   out.distance_m = d_after;
   out.inside_goal = d_after <= beta_m;
@@ -209,7 +232,7 @@ StepOutcome evaluate_step(const TaskConfig& c, double d_before, double d_after, 
     out.reason = flipped ? EndReason::kFlipped : EndReason::kLeftRegion;
     return out;
   }
-  const double cost = thrust_cost(c, action);
+  const double cost = thrust_cost(c, action) + command_change_cost(c, action, previous_action);
   if (out.inside_goal && !c.hold_mode) {
     out.reward = c.goal_reward;
     out.terminal = out.done = true;

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/task/randomisation.hpp"
 #include "common/vehicle_facts.hpp"
 
 namespace auvrl::config {
@@ -100,6 +101,10 @@ struct TaskConfig {
   /// ... and +precision_reward * exp(-d / precision_scale_m) per step.
   double precision_reward = 0.0;
   double precision_scale_m = 0.5;
+  /// The price of command changes, per step (both rewards, like the thrust cost):
+  /// -command_change_weight * mean_i (u_i,t - u_i,t-1)^2, u normalised to [-1, 1]. Every layout
+  /// carries the previous command u_t-1, so the reward stays a function of state and action.
+  double command_change_weight = 0.0;
 
   int max_steps = 700;  ///< 70 s of 0.1 s steps: a cut-off, not a terminal state
 
@@ -119,6 +124,10 @@ struct TaskConfig {
   Eigen::Vector3d start_attitude_spread_rad = Eigen::Vector3d::Zero();    ///< roll, pitch, yaw
   Eigen::Vector3d start_velocity_max_body_mps = Eigen::Vector3d::Zero();  ///< u, v, w
   Eigen::Vector3d start_rate_max_body_rad_s = Eigen::Vector3d::Zero();    ///< p, q, r
+
+  /// Randomised training episodes (training only, like the exploring starts): faults, currents,
+  /// sensor noise and model variation drawn per episode by the actors (randomisation.hpp).
+  EpisodeRandomisation randomise;
 
   /// Size of the observation vector.
   int state_dim() const;
@@ -185,15 +194,27 @@ struct StepOutcome {
 /// f(Tr): the thrust cost of one step's normalised action.
 double thrust_cost(const TaskConfig& config, const ActionVector& action);
 
+/// The price of changing the command from previous_action (u_t-1) to action (u_t):
+/// command_change_weight * mean((u_t - u_t-1)^2); 0 when previous_action is empty.
+double command_change_cost(const TaskConfig& config, const ActionVector& action,
+                           const ActionVector& previous_action);
+
+/// The previous action u_t-1 that an observation vector of the layout carries, into out (which
+/// allocates only when it is not already of the thruster count's size).
+void previous_action_from_state(const TaskConfig& config,
+                                const Eigen::Ref<const StateVector>& state, ActionVector& out);
+
 /// True when roll or pitch is beyond the flip angle (Euler angles are singular at 90 deg).
 bool is_flipped(const TaskConfig& config, const Eigen::Vector3d& euler_rpy_rad);
 
 /// Reward and termination of one transition, from the distances to the goal before and after
-/// it, whether the vehicle flipped, the action and the goal radius. steps_taken counts this
-/// step (the time limit cuts the episode off at config.max_steps).
+/// it, whether the vehicle flipped, the action, the goal radius and the previous action (for the
+/// command change price; empty: none). steps_taken counts this step (the time limit cuts the
+/// episode off at config.max_steps).
 StepOutcome evaluate_step(const TaskConfig& config, double distance_before_m,
                           double distance_after_m, bool flipped, const ActionVector& action,
-                          double beta_m, int steps_taken);
+                          double beta_m, int steps_taken,
+                          const ActionVector& previous_action = ActionVector());
 
 /// Draws a way-point uniformly in the configured box.
 Eigen::Vector3d sample_goal(const TaskConfig& config, std::mt19937_64& rng);

@@ -19,6 +19,67 @@ config::Table<ObservationScales> make_scales_table() {
   return t;
 }
 
+/// Randomised training episodes: per kind a probability and [low, high] ranges (uniform).
+config::Table<EpisodeRandomisation> make_randomise_table() {
+  using R = EpisodeRandomisation;
+  config::Table<R> t("randomise",
+                     "randomised training episodes (actors only): per kind, the share of "
+                     "episodes that get it and [low, high] ranges drawn uniformly");
+  t.field("fault_probability", &R::fault_probability, "",
+          "share of episodes with one thruster, chosen uniformly, impaired")
+      .range(0.0, 1.0);
+  t.field("fault_efficiency", &R::fault_efficiency, "[low, high] in 0..1",
+          "the share of its thrust that thruster gives");
+  t.field("current_probability", &R::current_probability, "",
+          "share of episodes with a constant horizontal current from a uniform direction")
+      .range(0.0, 1.0);
+  t.field("current_speed_mps", &R::current_speed_mps, "[low, high] m/s", "its speed");
+  t.field("varying_current_probability", &R::varying_current_probability, "",
+          "share of episodes with a slowly varying (Gauss-Markov) current, uniform heading")
+      .range(0.0, 1.0);
+  t.field("varying_current_sigma_mps", &R::varying_current_sigma_mps, "[low, high] m/s",
+          "white-noise intensity of its speed (from 0)");
+  t.field("varying_current_time_constant_s", &R::varying_current_time_constant_s,
+          "[low, high] s, > 0", "its time constant");
+  t.field("sensor_noise_probability", &R::sensor_noise_probability, "",
+          "share of episodes with Gaussian noise on what the vehicle reports")
+      .range(0.0, 1.0);
+  t.field("sensor_noise_scale", &R::sensor_noise_scale, "[low, high], >= 0",
+          "one factor per episode on the four levels below");
+  t.field("sensor_noise_position_m", &R::sensor_noise_position_m, "m", "position noise level")
+      .range(0.0);
+  t.field("sensor_noise_attitude_rad", &R::sensor_noise_attitude_rad, "rad",
+          "roll, pitch, yaw noise level")
+      .range(0.0);
+  t.field("sensor_noise_velocity_mps", &R::sensor_noise_velocity_mps, "m/s",
+          "body velocity noise level")
+      .range(0.0);
+  t.field("sensor_noise_angular_rate_rad_s", &R::sensor_noise_angular_rate_rad_s, "rad/s",
+          "body rate noise level")
+      .range(0.0);
+  t.field("model_probability", &R::model_probability, "",
+          "share of episodes on a model that differs from the vehicle file (all below drawn)")
+      .range(0.0, 1.0);
+  t.field("quadratic_damping_scale", &R::quadratic_damping_scale, "[low, high], > 0",
+          "x every quadratic damping coefficient");
+  t.field("added_mass_scale", &R::added_mass_scale, "[low, high], > 0",
+          "x every added-mass derivative");
+  t.field("mass_scale", &R::mass_scale, "[low, high], > 0",
+          "x mass and inertia (ballasted to the file's trim)");
+  t.field("thrust_scale", &R::thrust_scale, "[low, high] in (0, 1]",
+          "x every thruster's efficiency");
+  t.field("thruster_lag_time_constant_s", &R::thruster_lag_time_constant_s,
+          "[low, high] s; [0, 0]: the file's", "the thrusters' lag time constant");
+  t.field("extra_buoyancy_n", &R::extra_buoyancy_n, "[low, high] N",
+          "added to the buoyancy (> 0: lighter)");
+  t.validate([](const config::Section& s, R& r) {
+    std::string key;
+    const std::string what = r.check(key);
+    if (!what.empty()) s.fail(key, what);
+  });
+  return t;
+}
+
 /// The reward's terms.
 void add_reward_fields(config::Table<TaskConfig>& t) {
   using C = TaskConfig;
@@ -42,6 +103,9 @@ void add_reward_fields(config::Table<TaskConfig>& t) {
   t.field("precision_reward", &C::precision_reward, "per step",
           "shaped reward: +precision_reward * exp(-d / precision_scale_m)");
   t.field("precision_scale_m", &C::precision_scale_m, "m", "scale of the precision term");
+  t.field("command_change_weight", &C::command_change_weight, "0: off",
+          "price of command changes: -w * mean((u_t - u_t-1)^2) per step (u_t-1 is in the state)")
+      .range(0.0);
 }
 
 /// Episode length, start and goal region.
@@ -61,6 +125,7 @@ void add_episode_fields(config::Table<TaskConfig>& t) {
           "random starts: u, v, w uniform in +- this");
   t.field("start_rate_max_body_rad_s", &C::start_rate_max_body_rad_s, "rad/s",
           "random starts: p, q, r uniform in +- this");
+  t.section("randomise", make_randomise_table(), &C::randomise);
 }
 
 config::Table<TaskConfig> make_task_table() {

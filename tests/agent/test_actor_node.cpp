@@ -2,11 +2,14 @@
 // one in-process bus (the server answers inside the actor's own lockstep waits), no learner (the
 // policy is zero until weights arrive). A demonstration is driven by the demonstrator, its
 // experience goes out like any other and it is not reported as an episode; expert labels are
-// the expert's command in each transition's state.
+// the expert's command in each transition's state. Randomised episodes (task.randomise) reach
+// the simulator and leave the way-points alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -33,7 +36,10 @@ class ActorDemonstrations : public ::testing::Test {
         server_(model_, *bus_, server_config()) {
     transport::subscribe<auvrl_lcm::episode_report_t>(
         *bus_, channels::kEpisode,
-        [this](const std::string&, const auvrl_lcm::episode_report_t&) { ++reports_; });
+        [this](const std::string&, const auvrl_lcm::episode_report_t& m) {
+          ++reports_;
+          report_conditions_.push_back(m.conditions);
+        });
     transport::subscribe<auvrl_lcm::experience_batch_t>(
         *bus_, channels::kExperience,
         [this](const std::string&, const auvrl_lcm::experience_batch_t& m) {
@@ -68,6 +74,7 @@ class ActorDemonstrations : public ::testing::Test {
   sim::SimServer server_;
   std::ostringstream log_;
   int reports_ = 0;
+  std::vector<std::int32_t> report_conditions_;
   std::int64_t transitions_ = 0;
   std::vector<auvrl_lcm::experience_batch_t> batches_;
 };
@@ -160,6 +167,91 @@ TEST_F(ActorDemonstrations, ExpertLabelsAreThePidsCommandInEachState) {
   ActorNodeConfig no_expert = config(0.0);
   no_expert.expert_labels = true;
   EXPECT_THROW(ActorNode(no_expert, *bus_, log_), std::invalid_argument);
+}
+
+// A fault drawn by the actor reaches auv_sim: the PID drives (so every thruster is asked for
+// thrust), and the weak thruster's realised thrust (in the extended_thrust state) stays at zero
+// for the whole episode. The way-points are those of an actor that randomises nothing.
+TEST_F(ActorDemonstrations, RandomisedEpisodesReachTheSimulatorAndLeaveTheGoalsAlone) {
+  const int episodes = 6;
+  const auto goals_of = [&](const ActorNodeConfig& c, std::vector<int>* fault_thrusters) {
+    batches_.clear();
+    ActorNode node(c, *bus_, log_);
+    for (int i = 0; i < episodes; ++i) {
+      node.run_one_episode();
+      if (fault_thrusters) fault_thrusters->push_back(node.last_conditions().fault_thruster);
+    }
+    bus_->drain();
+    std::vector<std::vector<float>> goals;
+    for (const auto& m : batches_) goals.push_back(m.goal_ned_m.front());
+    return goals;
+  };
+  ActorNodeConfig plain = config(1.0);
+  plain.task.max_steps = 40;
+  ActorNodeConfig randomised = plain;
+  randomised.task.randomise.fault_probability = 1.0;
+  randomised.task.randomise.fault_efficiency = task::Range(0.0, 0.0);
+  randomised.task.randomise.current_probability = 0.5;
+  randomised.task.randomise.model_probability = 0.5;
+  randomised.task.randomise.thrust_scale = task::Range(0.7, 0.9);
+
+  const auto plain_goals = goals_of(plain, nullptr);
+  std::vector<int> faults;
+  const auto randomised_goals = goals_of(randomised, &faults);
+  EXPECT_EQ(randomised_goals, plain_goals);
+  ASSERT_EQ(static_cast<int>(batches_.size()), episodes);  // one batch per 40-step episode
+  const int n = plain.task.num_thrusters;
+  for (int e = 0; e < episodes; ++e) {
+    const auto& m = batches_[static_cast<std::size_t>(e)];
+    const int weak = faults[static_cast<std::size_t>(e)];
+    ASSERT_GE(weak, 0);
+    double weak_sum = 0.0, others_max = 0.0;
+    for (const auto& state : m.next_states) {
+      for (int k = 0; k < n; ++k) {
+        const double thrust = std::abs(state[static_cast<std::size_t>(m.state_dim - n + k)]);
+        if (k == weak) {
+          weak_sum += thrust;
+        } else {
+          others_max = std::max(others_max, thrust);
+        }
+      }
+    }
+    EXPECT_EQ(weak_sum, 0.0) << "episode " << e << ", thruster " << weak;
+    EXPECT_GT(others_max, 0.05) << "episode " << e;
+  }
+  EXPECT_EQ(server_.vehicle(0)->thruster_efficiency[faults.back()], 0.0);
+
+  // The policy's episodes report what was drawn.
+  randomised.demonstration_fraction = 0.0;
+  randomised.demonstrator.reset();
+  ActorNode node(randomised, *bus_, log_);
+  for (int i = 0; i < 4; ++i) node.run_one_episode();
+  bus_->drain();
+  ASSERT_EQ(report_conditions_.size(), 4u);
+  EXPECT_EQ(static_cast<unsigned>(report_conditions_.back()), node.last_conditions().kinds);
+  for (std::int32_t bits : report_conditions_) {
+    EXPECT_TRUE(bits & auvrl_lcm::episode_report_t::CONDITION_FAULT);
+  }
+}
+
+// The paper and fast presets randomise nothing (the paper's stays literal); robust.yaml turns
+// every kind on.
+TEST(ActorConfigFile, OnlyTheRobustPresetRandomisesEpisodes) {
+  for (const std::string preset : {"paper", "fast", "robust"}) {
+    ActorNodeConfig c;
+    read_actor_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml", c);
+    const task::EpisodeRandomisation& r = c.task.randomise;
+    if (preset != "robust") {
+      EXPECT_FALSE(r.any()) << preset;
+      EXPECT_EQ(c.task.command_change_weight, 0.0) << preset;
+      continue;
+    }
+    for (double p : {r.fault_probability, r.current_probability, r.varying_current_probability,
+                     r.sensor_noise_probability, r.model_probability}) {
+      EXPECT_GT(p, 0.0);
+    }
+    EXPECT_NO_THROW(c.task.validate());
+  }
 }
 
 TEST(ActorConfigFile, ReadsDemonstrationsExpertLabelsAndTheVehicle) {

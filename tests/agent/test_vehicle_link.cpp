@@ -1,7 +1,7 @@
 // Both vehicle links start an episode where EpisodeStart says: pose and body velocities (the
-// exploring starts of training depend on it) and sensor noise, in this process and through
-// auv_sim's server over the in-process transport; only the in-process link takes a mission's
-// events mid-run.
+// exploring starts of training depend on it), sensor noise, faults, current and model variation,
+// in this process and through auv_sim's server over the in-process transport; only the
+// in-process link takes a mission's events mid-run.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -104,6 +104,60 @@ TEST(VehicleLink, BothLinksDrawTheStartsSensorNoiseOnlyInProcessTakesEventsMidRu
                std::invalid_argument);
   EXPECT_FALSE(lockstep->set_thruster_efficiency(std::vector<double>(6, 0.5)));
   EXPECT_FALSE(lockstep->set_current(Eigen::Vector3d(0.1, 0.0, 0.0)));
+}
+
+// What training's randomisation draws (a weak thruster, a current, a wrong model) reaches auv_sim
+// through the lockstep link: the same episode as in process, step for step.
+TEST(VehicleLink, BothLinksRunTheSameVariedEpisode) {
+  const sim::VehicleModel model = nessie();
+  EpisodeStart start = moving_start();
+  start.thruster_efficiency = {0.7, 0.1, 0.7, 0.7, 0.7, 0.7};
+  start.current_ned_mps = Eigen::Vector3d(0.2, -0.3, 0.0);
+  start.current_varying_sigma_mps = 0.05;
+  start.current_varying_time_constant_s = 30.0;
+  start.current_varying_direction_rad = 1.0;
+  start.model_variation.quadratic_damping_scale = 0.6;
+  start.model_variation.added_mass_scale = 1.5;
+  start.model_variation.mass_scale = 1.2;
+  start.model_variation.thruster_lag_time_constant_s = 0.6;
+  start.model_variation.extra_buoyancy_n = 19.6;
+  start.seed = 11;
+  std::unique_ptr<VehicleLink> in_process = make_in_process_link(model);
+  std::unique_ptr<transport::Transport> bus = transport::make_in_process_transport();
+  sim::SimServerConfig config;
+  config.heartbeat_period_s = 3600;
+  sim::SimServer server(model, *bus, config);
+  std::unique_ptr<VehicleLink> lockstep = make_lockstep_link(*bus, 0, model.facts());
+  // Twice: the second episode reuses the simulator's varied model.
+  for (int episode = 0; episode < 2; ++episode) {
+    ASSERT_TRUE(in_process->reset(start).has_value());
+    ASSERT_TRUE(lockstep->reset(start).has_value());
+    std::optional<VehicleReport> local, remote;
+    for (int k = 0; k < 30; ++k) {
+      const std::vector<double> thrust = {30, 30, -10, 10, 5, -5};
+      local = in_process->step(thrust);
+      remote = lockstep->step(thrust);
+      ASSERT_TRUE(local.has_value() && remote.has_value());
+    }
+    EXPECT_TRUE(
+        remote->observation.position_ned_m.isApprox(local->observation.position_ned_m, 1e-12));
+    EXPECT_TRUE(remote->observation.velocity_body_mps.isApprox(local->observation.velocity_body_mps,
+                                                               1e-12));
+    EXPECT_EQ(remote->thrust_realised_n, local->thrust_realised_n);
+    // T2 at 10 %: its realised thrust is a seventh of T1's (both commanded 30 N).
+    EXPECT_NEAR(remote->thrust_realised_n[1], remote->thrust_realised_n[0] / 7.0, 1e-9);
+  }
+  // The same start without the variation steps differently.
+  EpisodeStart plain = start;
+  plain.model_variation = sim::ModelVariation{};
+  ASSERT_TRUE(lockstep->reset(plain).has_value());
+  ASSERT_TRUE(in_process->reset(start).has_value());
+  std::optional<VehicleReport> local, remote;
+  for (int k = 0; k < 30; ++k) {
+    local = in_process->step(std::vector<double>(6, 20.0));
+    remote = lockstep->step(std::vector<double>(6, 20.0));
+  }
+  EXPECT_GT((remote->observation.position_ned_m - local->observation.position_ned_m).norm(), 0.01);
 }
 
 TEST(VehicleLink, LockstepLinkRefusesAnotherVehicleNamingBoth) {

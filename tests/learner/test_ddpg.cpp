@@ -1,6 +1,8 @@
 // DDPG/TD3 update: targets and losses against a hand computation, terminal handling, which
 // networks move when, TD3's delay, the Q-filtered imitation term (gradient against finite
-// differences, the filter, its effect), allocation-free updates, and exact save/restore.
+// differences, the filter, its effect), the smoothness terms (CAPS: gradient against finite
+// differences, their effect, off changes nothing), allocation-free updates, and exact
+// save/restore.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 false positive in Eigen AVX-512
 #pragma GCC diagnostic ignored "-Wuninitialized"
@@ -11,6 +13,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "alloc_counter.hpp"
 #include "learner/bench.hpp"
@@ -366,20 +369,175 @@ TEST(Ddpg, ImitationWeightHalvesEveryHalfLife) {
   EXPECT_THROW(config.validate(), std::invalid_argument);
 }
 
+TEST(DdpgConfig, SmoothnessIsOffByDefaultAndNegativeWeightsAreRefusedNamingTheKey) {
+  const DdpgConfig c;
+  EXPECT_EQ(c.smooth_temporal_weight, 0.0f);
+  EXPECT_EQ(c.smooth_spatial_weight, 0.0f);
+  for (const char* key :
+       {"smooth_temporal_weight", "smooth_spatial_weight", "smooth_spatial_sigma"}) {
+    for (float bad : {-0.1f, std::nanf(""), INFINITY}) {
+      DdpgConfig d = small_config(Algo::kTd3);
+      float& value = std::string(key) == "smooth_temporal_weight"  ? d.smooth_temporal_weight
+                     : std::string(key) == "smooth_spatial_weight" ? d.smooth_spatial_weight
+                                                                   : d.smooth_spatial_sigma;
+      value = bad;
+      try {
+        d.validate();
+        ADD_FAILURE() << key << " = " << bad << " was accepted";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+// The actor's loss with the smoothness terms, as DdpgConfig documents it, evaluated on the side:
+// -mean Q(x, mu(x)) + q_scale * (w_T D(x, x') + w_S D(x, z)), D(a, b) = 1/N sum_i mean_j
+// (mu_j(a_i) - mu_j(b_i))^2, z the perturbed states the learner drew; q_scale held fixed.
+double smoothness_loss(const nn::Mlp& actor, const nn::Mlp& critic, const Batch& b,
+                       const nn::Matrix& perturbed, double w_t, double w_s, double q_scale) {
+  const int n = b.size;
+  const nn::Matrix x = b.state.leftCols(n);
+  const nn::Matrix mu = eval(actor, x);
+  const double entries = static_cast<double>(n) * static_cast<double>(mu.rows());
+  double loss = -static_cast<double>(eval(critic, x, mu).mean());
+  if (w_t > 0) {
+    const nn::Matrix next = eval(actor, nn::Matrix(b.next_state.leftCols(n)));
+    loss += w_t * q_scale * (mu - next).cast<double>().squaredNorm() / entries;
+  }
+  if (w_s > 0) {
+    const nn::Matrix other = eval(actor, perturbed);
+    loss += w_s * q_scale * (mu - other).cast<double>().squaredNorm() / entries;
+  }
+  return loss;
+}
+
+// The actor's gradient with the temporal term, the spatial term and both, against central
+// differences of the loss above along the gradient and a random direction. As for imitation, the
+// critic first learns from large rewards (mean|Q| far from 0); the actor learns too, without
+// the terms (its initial commands are all near 0, so the terms would be near 0); then a learner
+// with the terms and an actor's rate of 0 takes over that state for the step checked.
+TEST(Ddpg, SmoothnessTermsGradientMatchesFiniteDifferences) {
+  for (const auto& [w_t, w_s] : {std::pair{20.0f, 0.0f}, {0.0f, 20.0f}, {10.0f, 20.0f}}) {
+    DdpgConfig config = small_config(Algo::kDdpg);
+    config.actor_lr = 1e-3f;
+    config.critic_lr = 1e-2f;
+    config.critic_weight_decay = 0.0f;
+    Ddpg trained(config);
+    nn::Rng rng(31);
+    Batch b = random_batch(rng, 5, 2, 8, 0.0f);
+    b.reward.leftCols(b.size).array() += 20.0f;
+    for (int i = 0; i < 200; ++i) trained.update(b);
+    std::stringstream saved;
+    trained.save(saved);
+    config.actor_lr = 0.0f;
+    config.smooth_temporal_weight = w_t;
+    config.smooth_spatial_weight = w_s;
+    config.smooth_spatial_sigma = 0.3f;
+    Ddpg learner(config);
+    learner.restore(saved);
+    const nn::Mlp actor0 = learner.actor();
+
+    const UpdateStats stats = learner.update(b);
+    ASSERT_TRUE(stats.actor_updated);
+    const nn::Vector grad = learner.actor().grads();
+    const nn::Mlp& critic = learner.critic();
+    const nn::Matrix perturbed = learner.last_perturbed_states();
+    ASSERT_EQ(perturbed.cols(), w_s > 0 ? b.size : 0);
+    const nn::Matrix x = b.state.leftCols(b.size);
+    const double q_scale = eval(critic, x, eval(actor0, x)).cwiseAbs().mean();
+    ASSERT_GT(q_scale, 10.0);
+    // The terms' values as reported.
+    const auto term = [&](const nn::Matrix& z) {
+      return (eval(actor0, x) - eval(actor0, z)).squaredNorm() / (b.size * 2.0);
+    };
+    if (w_t > 0) {
+      EXPECT_NEAR(stats.smooth_temporal, term(b.next_state.leftCols(b.size)), 1e-6);
+    }
+    if (w_s > 0) {
+      EXPECT_NEAR(stats.smooth_spatial, term(perturbed), 1e-6);
+      EXPECT_GT(stats.smooth_spatial, 0.0f);
+      const double spread = std::sqrt((perturbed - x).squaredNorm() / (5.0 * b.size));
+      EXPECT_NEAR(spread, 0.3, 0.12);  // the perturbation's standard deviation
+    }
+
+    nn::Vector random_dir(grad.size());
+    for (Eigen::Index i = 0; i < random_dir.size(); ++i) random_dir[i] = nn::uniform(rng, -1, 1);
+    for (const nn::Vector& dir :
+         {nn::Vector(grad.normalized()), nn::Vector(random_dir.normalized())}) {
+      const float eps = 1e-3f;
+      nn::Mlp plus = actor0, minus = actor0;
+      plus.params() += eps * dir;
+      minus.params() -= eps * dir;
+      const auto slope = [&](double t, double sp) {
+        return (smoothness_loss(plus, critic, b, perturbed, t, sp, q_scale) -
+                smoothness_loss(minus, critic, b, perturbed, t, sp, q_scale)) /
+               (2.0 * eps);
+      };
+      const double numeric = slope(w_t, w_s);
+      const double tolerance = 0.02 * grad.norm();
+      EXPECT_NEAR(grad.dot(dir), numeric, tolerance) << w_t << " " << w_s;
+      // The terms are a real part of the gradient: leaving them out misses it.
+      if (dir.dot(grad) > 0.99f * grad.norm()) {
+        EXPECT_GT(std::abs(slope(0, 0) - numeric), 5 * tolerance) << w_t << " " << w_s;
+      }
+    }
+  }
+}
+
+// On a fixed batch, the temporal term brings the commands in x and x' together and the spatial
+// term those in x and nearby states, compared with the same learner without them; with both
+// weights 0 the spatial sigma changes nothing (no draw, the same updates).
+TEST(Ddpg, SmoothnessTermsMakeTheCommandsCloser) {
+  DdpgConfig config = small_config(Algo::kTd3);
+  config.actor_lr = 3e-3f;
+  config.critic_weight_decay = 0.0f;
+  nn::Rng rng(32);
+  Batch b = random_batch(rng, 5, 2, 8, 0.0f);
+  b.reward.leftCols(b.size).array() += 20.0f;
+  const nn::Matrix x = b.state.leftCols(b.size);
+  const nn::Matrix x_next = b.next_state.leftCols(b.size);
+  nn::Matrix nearby = x;
+  for (Eigen::Index i = 0; i < nearby.size(); ++i) nearby(i) += 0.3f * nn::uniform(rng, -1, 1);
+  const auto train = [&](float w_t, float w_s, float sigma) {
+    DdpgConfig c = config;
+    c.smooth_temporal_weight = w_t;
+    c.smooth_spatial_weight = w_s;
+    c.smooth_spatial_sigma = sigma;
+    Ddpg learner(c);
+    for (int i = 0; i < 600; ++i) learner.update(b);
+    return learner.actor();
+  };
+  const auto gap = [&](const nn::Mlp& actor, const nn::Matrix& other) {
+    return (eval(actor, x) - eval(actor, other)).norm();
+  };
+  const nn::Mlp plain = train(0, 0, 0.05f);
+  EXPECT_EQ(train(0, 0, 0.7f).params(), plain.params());
+  const nn::Mlp temporal = train(2.0f, 0, 0.05f);
+  EXPECT_LT(gap(temporal, x_next), 0.5 * gap(plain, x_next))
+      << gap(plain, x_next) << " -> " << gap(temporal, x_next);
+  const nn::Mlp spatial = train(0, 2.0f, 0.3f);
+  EXPECT_LT(gap(spatial, nearby), 0.7 * gap(plain, nearby))
+      << gap(plain, nearby) << " -> " << gap(spatial, nearby);
+}
+
 TEST(Ddpg, UpdatesAllocateNothing) {
   for (Algo algo : {Algo::kDdpg, Algo::kTd3}) {
-    DdpgConfig config;
-    config.algo = algo;
-    config.state_dim = 29;
-    config.action_dim = 6;
-    config.critic_grad_clip_norm = 10.0f;
-    Ddpg learner(config);  // the paper's 400-300, batch 64
-    nn::Rng rng(1);
-    const ReplayBuffer replay = random_replay(rng, 29, 6, 500);
-    learner.update(replay);
-    test::AllocationCounter counter;
-    for (int i = 0; i < 4; ++i) learner.update(replay);
-    EXPECT_EQ(counter.count(), 0) << to_string(algo);
+    for (bool smooth : {false, true}) {
+      DdpgConfig config;
+      config.algo = algo;
+      config.state_dim = 29;
+      config.action_dim = 6;
+      config.critic_grad_clip_norm = 10.0f;
+      if (smooth) config.smooth_temporal_weight = config.smooth_spatial_weight = 0.1f;
+      Ddpg learner(config);  // the paper's 400-300, batch 64
+      nn::Rng rng(1);
+      const ReplayBuffer replay = random_replay(rng, 29, 6, 500);
+      learner.update(replay);
+      test::AllocationCounter counter;
+      for (int i = 0; i < 4; ++i) learner.update(replay);
+      EXPECT_EQ(counter.count(), 0) << to_string(algo) << (smooth ? " smooth" : "");
+    }
   }
 }
 
@@ -389,7 +547,9 @@ TEST(Ddpg, SaveRestoreGivesIdenticalSubsequentUpdates) {
   for (Algo algo : {Algo::kDdpg, Algo::kTd3}) {
     nn::Rng rng(21);
     const ReplayBuffer replay = random_replay(rng, 5, 2, 200);
-    Ddpg original(small_config(algo));
+    DdpgConfig config = small_config(algo);
+    if (algo == Algo::kTd3) config.smooth_spatial_weight = 0.2f;  // draws from the RNG too
+    Ddpg original(config);
     for (int i = 0; i < 7; ++i) original.update(replay);
     std::stringstream saved;
     original.save(saved);
@@ -397,7 +557,7 @@ TEST(Ddpg, SaveRestoreGivesIdenticalSubsequentUpdates) {
     std::vector<UpdateStats> expected;
     for (int i = 0; i < 5; ++i) expected.push_back(original.update(replay));
 
-    DdpgConfig other = small_config(algo);
+    DdpgConfig other = config;
     other.seed = 999;
     Ddpg restored(other);
     restored.restore(saved);
@@ -496,6 +656,14 @@ TEST(Bench, TheFastPresetCaseWithImitationRunsAndSaysSo) {
   BenchCase plain = fast_preset_bench_case(0.0f);
   plain.seconds = 0.05;
   EXPECT_EQ(format_bench_line(run_update_benchmark(plain)).find("expert"), std::string::npos);
+  BenchCase smooth = fast_preset_bench_case(0.4f);
+  smooth.smooth_temporal_weight = 0.1f;
+  smooth.seconds = 0.05;
+  const BenchResult s = run_update_benchmark(smooth);
+  EXPECT_GT(s.updates, 0);
+  EXPECT_NE(format_bench_line(s).find(" smooth_temporal_weight=0.1 smooth_spatial_weight=0"),
+            std::string::npos)
+      << format_bench_line(s);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Hindsight relabelling: a relabelled transition equals the transition the task would have
-// produced had the episode's goal been the relabelled one (states, reward, termination).
+// produced had the episode's goal been the relabelled one (states, reward with the command change
+// price, termination).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -37,6 +38,7 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
   task::TaskConfig cfg;
   cfg.layout = GetParam();
   cfg.reward = task::RewardKind::kShaped;
+  cfg.command_change_weight = 0.5;  // its u_t-1 comes from the stored state
   const int n = 40;
   const auto steps = make_episode(n);
   const Eigen::Vector3d goal(20.0, -5.0, 12.0);
@@ -51,7 +53,7 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
     task::build_state(cfg, steps[t + 1].obs, goal, steps[t].action, s2);
     const double d0 = (goal - steps[t].obs.position_ned_m).norm();
     const double d1 = (goal - steps[t + 1].obs.position_ned_m).norm();
-    const auto out = task::evaluate_step(cfg, d0, d1, false, steps[t].action, beta, t + 1);
+    const auto out = task::evaluate_step(cfg, d0, d1, false, steps[t].action, beta, t + 1, prev);
     const learner::TransitionView view{s,
                                        steps[t].action,
                                        static_cast<float>(out.reward),
@@ -96,7 +98,9 @@ TEST_P(HindsightTest, RelabelledTransitionsEqualThoseBuiltForTheNewGoal) {
         EXPECT_LT((expect2 - batch.next_state.col(i)).cwiseAbs().maxCoeff(), 2e-4f);
         const double d0 = (g - steps[t].obs.position_ned_m).norm();
         const double d1 = (g - steps[t + 1].obs.position_ned_m).norm();
-        const auto out = task::evaluate_step(cfg, d0, d1, false, steps[t].action, beta, t + 1);
+        const auto out =
+            task::evaluate_step(cfg, d0, d1, false, steps[t].action, beta, t + 1,
+                                t > 0 ? steps[t - 1].action : task::ActionVector::Zero(6));
         EXPECT_NEAR(batch.reward(0, i), out.reward, 1e-3);
         EXPECT_EQ(batch.terminal(0, i) > 0.5f, out.terminal);
         matched = true;

@@ -3,11 +3,13 @@
 // expert labels, too many or no transitions, unknown actor ids, and episode reports from unknown
 // actors are dropped and counted; nothing of them reaches the replay buffer, the updates or the
 // schedule. Sound experience of other sizes (an actor of another vehicle) stops the learner.
+// LEARNER_STATS carries the smoothness terms' values.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
+#include <auvrl_lcm/learner_stats_t.hpp>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -204,6 +206,27 @@ TEST_F(LearnerNodeInput, UndecodableBytesAreCounted) {
   EXPECT_EQ(node_->counters().dropped_decode, 3);
   EXPECT_EQ(node_->counters().weights_requests, 0);
   expect_untouched();
+}
+
+// With the temporal smoothness term on (and the spatial one off), LEARNER_STATS reports the
+// mean squared command change the actor steps saw.
+TEST_F(LearnerNodeInput, StatsReportTheSmoothnessTerms) {
+  config_.ddpg.smooth_temporal_weight = 0.5f;
+  config_.her = false;
+  node_.reset();
+  node_ = std::make_unique<learner::LearnerNode>(config_, *transport_, log_);
+  std::vector<auvrl_lcm::learner_stats_t> stats;
+  transport::subscribe<auvrl_lcm::learner_stats_t>(
+      *transport_, channels::kLearnerStats,
+      [&stats](const std::string&, const auvrl_lcm::learner_stats_t& m) { stats.push_back(m); });
+  for (int i = 0; i < 4; ++i) send(channels::kExperience, batch(40));
+  for (int i = 0; i < 50; ++i) node_->poll(0);
+  ASSERT_GT(node_->updates(), 10);
+  node_->finish();
+  transport_->drain();
+  ASSERT_FALSE(stats.empty());
+  EXPECT_GT(stats.back().smooth_temporal, 0.0);
+  EXPECT_EQ(stats.back().smooth_spatial, 0.0);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // auv_sim's handling of hostile messages with a valid LCM encoding, in-process (memq): wrong
 // thruster counts, NaN and inf, out-of-range values, unknown or mismatched vehicle ids, stale
-// sequence numbers and undecodable bytes are dropped and counted, and never change a vehicle.
+// sequence numbers and undecodable bytes are dropped and counted, and never change a vehicle. A
+// reset that varies the model gives that vehicle its own dynamics, until a reset says otherwise.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "common/channels.hpp"
 #include "common/transport.hpp"
+#include "sim/model_variation.hpp"
 #include "sim/sim_server.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -194,6 +196,99 @@ TEST_F(SimServerInput, StaleUnresetAndUndecodableMessagesAreDropped) {
   EXPECT_EQ(c.dropped_stale, 1);
   EXPECT_EQ(c.dropped_decode, 2);
   EXPECT_EQ(c.steps_total, 0);
+}
+
+/// A reset of vehicle id whose model has 1.5 x the drag and 19.6 N (2 kg) of extra buoyancy.
+auvrl_lcm::vehicle_reset_t varied_reset(int id, std::int64_t seq) {
+  auvrl_lcm::vehicle_reset_t m{};
+  m.vehicle_id = id;
+  m.seq = seq;
+  m.position_ned_m[2] = 5.0;
+  m.model_varied = true;
+  m.model_quadratic_damping_scale = 1.5;
+  m.model_added_mass_scale = 1.0;
+  m.model_mass_scale = 1.0;
+  m.model_thruster_lag_time_constant_s = -1.0;  // the file's
+  m.model_extra_buoyancy_n = 19.6;
+  return m;
+}
+
+// Two vehicles driven alike: the varied one is slower and rises, exactly as the dynamics library
+// steps that variation of the file's model; the next plain reset gives the file's model back.
+TEST_F(SimServerInput, AVariedResetGivesThatVehicleItsOwnDynamicsUntilTheNextReset) {
+  send(channels::sim_reset(0), reset(0));
+  send(channels::sim_reset(1), varied_reset(1, 1));
+  sim::ModelVariation variation;
+  variation.quadratic_damping_scale = 1.5;
+  variation.extra_buoyancy_n = 19.6;
+  const sim::VehicleModel varied = sim::vary_model(model_, variation);
+  sim::ResetSettings settings;
+  settings.eta[2] = 5.0;
+  sim::VehicleState local = sim::make_state(varied, settings);
+  sim::ThrusterVector thrust = sim::ThrusterVector::Zero(6);
+  thrust.head(2).setConstant(30.0);  // both surge thrusters
+  for (int k = 2; k < 52; ++k) {
+    auto cmd = command(0, k, 0.0);
+    cmd.thrust_n = {30.0, 30.0, 0, 0, 0, 0};
+    send(channels::sim_command(0), cmd);
+    cmd.vehicle_id = 1;
+    send(channels::sim_command(1), cmd);
+    sim::step(varied, local, thrust);
+  }
+  const sim::VehicleState& nominal = *server_.vehicle(0);
+  const sim::VehicleState& remote = *server_.vehicle(1);
+  EXPECT_EQ(remote.eta, local.eta);
+  EXPECT_EQ(remote.nu, local.nu);
+  EXPECT_LT(remote.nu[0], nominal.nu[0] - 0.05) << "more drag: slower";
+  EXPECT_LT(remote.eta[2], nominal.eta[2] - 0.1) << "more buoyancy: shallower";
+
+  // A plain reset (model_varied false) is the file's model again: both vehicles step alike.
+  send(channels::sim_reset(0), reset(0, 100));
+  send(channels::sim_reset(1), reset(1, 100));
+  for (int k = 101; k < 111; ++k) {
+    send(channels::sim_command(0), command(0, k));
+    send(channels::sim_command(1), command(1, k));
+  }
+  EXPECT_EQ(server_.vehicle(0)->eta, server_.vehicle(1)->eta);
+  EXPECT_EQ(server_.counters().resets_total, 4);
+}
+
+// A variation that is not finite or has a scale not above 0 is dropped (counted like the other
+// reset fields) and leaves the vehicle as it was; with model_varied false the fields are ignored.
+TEST_F(SimServerInput, BadModelVariationsAreDroppedAndCounted) {
+  send(channels::sim_reset(0), varied_reset(0, 1));
+  const sim::Vector6 eta_before = server_.vehicle(0)->eta;
+  auto r = varied_reset(0, 2);
+  r.model_mass_scale = std::nan("");
+  send(channels::sim_reset(0), r);
+  r = varied_reset(0, 3);
+  r.model_extra_buoyancy_n = kInf;
+  send(channels::sim_reset(0), r);
+  r = varied_reset(0, 4);
+  r.model_added_mass_scale = 0.0;  // as a zero-initialised field would be
+  send(channels::sim_reset(0), r);
+  r = varied_reset(0, 5);
+  r.model_quadratic_damping_scale = -1.5;
+  send(channels::sim_reset(0), r);
+  auto c = server_.counters();
+  EXPECT_EQ(c.dropped_non_finite, 2);
+  EXPECT_EQ(c.dropped_out_of_range, 2);
+  EXPECT_EQ(c.resets_total, 1);
+  EXPECT_EQ(server_.vehicle(0)->eta, eta_before);
+  // The varied model stays: it still rises faster than the file's vehicle would.
+  send(channels::sim_reset(1), reset(1));
+  for (int k = 2; k < 32; ++k) {
+    send(channels::sim_command(0), command(0, k, 0.0));
+    send(channels::sim_command(1), command(1, k, 0.0));
+  }
+  EXPECT_LT(server_.vehicle(0)->eta[2], server_.vehicle(1)->eta[2] - 0.05);
+
+  r = reset(0, 40);  // model_varied false: the zero scales mean nothing
+  r.model_mass_scale = std::nan("");
+  send(channels::sim_reset(0), r);
+  c = server_.counters();
+  EXPECT_EQ(c.resets_total, 3);
+  EXPECT_EQ(c.dropped_non_finite, 2);
 }
 
 }  // namespace

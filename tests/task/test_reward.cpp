@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "common/task/task.hpp"
 
@@ -168,6 +170,43 @@ TEST(Reward, PaperRewardIgnoresTheShapedTerms) {
   EXPECT_DOUBLE_EQ(evaluate_step(c, 0.8, 0.1, false, uniform_action(0.0f), 0.5, 1).reward, 10.0);
 }
 
+// The command change price: -w * mean((u_t - u_t-1)^2) on every step that is not the goal or a
+// failure, in both rewards; nothing without a previous command or with w = 0; u_t-1 as every
+// layout's state carries it.
+TEST(Reward, CommandChangesArePricedWhenAsked) {
+  for (RewardKind kind : {RewardKind::kPaper, RewardKind::kShaped}) {
+    TaskConfig c;
+    c.reward = kind;
+    ActionVector a(6), previous(6);
+    a << 1.0f, -1.0f, 0.5f, 0.0f, 0.0f, -0.5f;
+    previous << 0.0f, -1.0f, 0.5f, 0.5f, 0.0f, 0.5f;  // squared changes 1 + 0.25 + 1 = 2.25
+    const double plain = evaluate_step(c, 5.0, 4.0, false, a, 0.5, 1).reward;
+    EXPECT_DOUBLE_EQ(evaluate_step(c, 5.0, 4.0, false, a, 0.5, 1, previous).reward, plain);
+    c.command_change_weight = 0.4;
+    EXPECT_NEAR(command_change_cost(c, a, previous), 0.4 * 2.25 / 6.0, 1e-12);
+    EXPECT_NEAR(evaluate_step(c, 5.0, 4.0, false, a, 0.5, 1, previous).reward,
+                plain - 0.4 * 2.25 / 6.0, 1e-12);
+    EXPECT_DOUBLE_EQ(evaluate_step(c, 5.0, 4.0, false, a, 0.5, 1, a).reward, plain);
+    EXPECT_DOUBLE_EQ(evaluate_step(c, 5.0, 4.0, false, a, 0.5, 1).reward, plain);
+    EXPECT_DOUBLE_EQ(evaluate_step(c, 0.8, 0.4, false, a, 0.5, 1, previous).reward, c.goal_reward);
+    EXPECT_DOUBLE_EQ(evaluate_step(c, 5.0, 25.0, false, a, 0.5, 1, previous).reward,
+                     c.failure_reward);
+    EXPECT_THROW(command_change_cost(c, a, ActionVector::Zero(5)), std::invalid_argument);
+  }
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
+    TaskConfig c;
+    c.layout = layout;
+    ActionVector previous(6), read;
+    previous << 0.1f, -0.2f, 0.3f, -0.4f, 0.5f, -0.6f;
+    StateVector state;
+    build_state(c, Observation{}, Eigen::Vector3d(1.0, 2.0, 3.0), previous, state,
+                std::vector<double>(6, 5.0));
+    previous_action_from_state(c, state, read);
+    EXPECT_EQ(read, previous) << to_string(layout);
+  }
+}
+
 TEST(TaskConfig, ValidateRejectsUnusableValues) {
   EXPECT_NO_THROW(TaskConfig{}.validate());
   TaskConfig c;
@@ -203,6 +242,14 @@ TEST(TaskConfig, ValidateRejectsUnusableValues) {
   c = TaskConfig{};
   c.start_rate_max_body_rad_s.z() = std::numeric_limits<double>::infinity();
   EXPECT_THROW(c.validate(), std::invalid_argument);
+  c = TaskConfig{};
+  c.command_change_weight = -0.1;
+  try {
+    c.validate();
+    ADD_FAILURE() << "a negative command_change_weight was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("task.command_change_weight"), std::string::npos);
+  }
 }
 
 TEST(TaskConfig, ParsesNames) {
