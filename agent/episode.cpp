@@ -80,7 +80,12 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
   task::build_state(task, report->observation, goal, previous_action, state,
                     report->thrust_realised_n);
   double distance = (goal - report->observation.position_ned_m).norm();
-  summary.min_distance_m = distance;
+  // The figures measure where the vehicle is: its true position where the link knows it (a
+  // simulator in process, whose sensor noise only the controller sees), else what it reports.
+  const auto true_distance = [&goal](const VehicleReport& r, double reported_m) {
+    return r.true_position_ned_m ? (goal - *r.true_position_ned_m).norm() : reported_m;
+  };
+  summary.min_distance_m = true_distance(*report, distance);
   std::vector<double> thrust_n(static_cast<std::size_t>(n));
   double error_sum_after_reach = 0.0;
   int steps_after_reach = 0;
@@ -119,19 +124,20 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
     }
     summary.length_steps = t;
     summary.thrust_energy += static_cast<double>(action.squaredNorm()) / n;
-    summary.final_distance_m = next_distance;
-    summary.min_distance_m = std::min(summary.min_distance_m, next_distance);
-    if (summary.time_to_reach_s < 0 && next_distance <= options.reach_radius_m) {
+    const double measured_m = true_distance(*next, next_distance);
+    summary.final_distance_m = measured_m;
+    summary.min_distance_m = std::min(summary.min_distance_m, measured_m);
+    if (summary.time_to_reach_s < 0 && measured_m <= options.reach_radius_m) {
       summary.time_to_reach_s = t * task.control_step_s;
     }
     if (summary.time_to_reach_s >= 0) {
-      error_sum_after_reach += next_distance;
+      error_sum_after_reach += measured_m;
       ++steps_after_reach;
     }
     if (outcome.inside_goal) summary.success = true;
     if (options.trajectory) {
       options.trajectory->push_back(
-          {next->time_s, next->observation, thrust_n, next->thrust_realised_n, next_distance});
+          {next->time_s, next->observation, thrust_n, next->thrust_realised_n, measured_m});
     }
 
     report = std::move(next);

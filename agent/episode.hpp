@@ -54,7 +54,7 @@ struct TrajectoryRow {
   task::Observation observation;
   std::vector<double> thrust_command_n;
   std::vector<double> thrust_realised_n;
-  double distance_m = 0.0;
+  double distance_m = 0.0;  ///< from the true position where the link knows it (VehicleReport)
 };
 
 /// What an episode did.
@@ -62,6 +62,8 @@ struct EpisodeSummary {
   double episode_return = 0.0;
   int length_steps = 0;
   bool success = false;  ///< ended inside beta (or, in hold mode, was ever inside)
+  /// The distances below and the time to reach use the true position where the link knows it
+  /// (VehicleReport::true_position_ned_m), else the reported one.
   double final_distance_m = 0.0;
   double min_distance_m = 0.0;
   double thrust_energy = 0.0;  ///< sum of mean squared normalised commands

@@ -118,6 +118,7 @@ class InProcessLink final : public VehicleLink {
                                m.thrust_realised_n.data() + m.thrust_realised_n.size());
     r.time_s = m.time_s;
     r.blown_up = m.status != sim::StateStatus::kOk;
+    r.true_position_ned_m = state_->eta.head<3>();
     return r;
   }
 

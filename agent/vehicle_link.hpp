@@ -23,6 +23,10 @@ struct VehicleReport {
   std::vector<double> thrust_realised_n;  ///< per thruster, N
   double time_s = 0.0;                    ///< since the reset, s
   bool blown_up = false;                  ///< the simulator flagged a numerical blow-up
+  /// Where the vehicle truly is (NED, m), when the link knows it: a simulator in this process,
+  /// whose sensor noise only the observation carries. The episode's figures (time to reach,
+  /// hold error, final error) use it; the controller never sees it.
+  std::optional<Eigen::Vector3d> true_position_ned_m;
 };
 
 /// What a vehicle_state_t message reports (the simulator's, or a real vehicle's driver's).

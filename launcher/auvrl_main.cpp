@@ -18,6 +18,7 @@
 #include "launcher/launcher.hpp"
 #include "launcher/mission_replay.hpp"
 #include "launcher/mission_run.hpp"
+#include "launcher/refinetune.hpp"
 #include "tools/arrival_search.hpp"
 #include "tools/export/policy_export.hpp"
 #include "tuning/pid_tuning.hpp"
@@ -188,7 +189,7 @@ int run_train(int argc, const char* const* argv) {
       "private network namespace, shows progress, restarts crashed processes,\n"
       "stops cleanly on Ctrl-C, then fine-tunes the policy (finetune: in the configuration),\n"
       "evaluates it and the PID baseline, draws the plots and writes RUN/report.md.");
-  cli.option("preset", &preset, "config/presets/NAME.yaml (paper or fast)");
+  cli.option("preset", &preset, "config/presets/NAME.yaml (paper, fast or robust)");
   cli.option("config", &options.config_path, "a configuration file instead of a preset");
   cli.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the configuration's vehicle:); every process, the PID, "
@@ -289,6 +290,29 @@ int run_replay_command(int argc, const char* const* argv) {
   return auvrl::launcher::start_mission_replay(options, network == "host", std::cout);
 }
 
+/// `auvrl finetune`: a trained run's policy fine-tuned again and evaluated.
+int run_finetune_command(int argc, const char* const* argv) {
+  auvrl::launcher::RefinetuneOptions options;
+  options.source_dir = AUVRL_SOURCE_DIR;
+  auvrl::cli::CommandLine cli(
+      "auvrl finetune",
+      "Fine-tunes a trained run's policy again (evolution strategies, the finetune: section of\n"
+      "the run's configuration or of --config), then evaluates the kept policy and the PID on\n"
+      "the scenarios and the robustness suite, into OUT (finetune.csv, policy_finetuned.nn,\n"
+      "eval/, report.md). Runs in this process: no transport.");
+  cli.option("run-dir", &options.run_dir, "the trained run (its config.yaml and policy)");
+  cli.require("run-dir");
+  cli.option("out", &options.out_dir, "output directory (created)");
+  cli.require("out");
+  cli.option("config", &options.config_path, "take the finetune: section from this file");
+  cli.option("policy", &options.policy_path,
+             "the policy to fine-tune (default: the one the run's evaluation used)");
+  cli.option("iterations", &options.iterations, "fine-tuning iterations (default: the config's)");
+  cli.option("seed", &options.seed, "seed of the fine-tuning's way-points (default: the run's)");
+  if (!cli.parse(argc, argv)) return 0;
+  return auvrl::launcher::refinetune(options, std::cout);
+}
+
 /// `auvrl config-doc`: prints docs/configuration.md.
 int run_config_doc(int argc, const char* const* argv) {
   auvrl::cli::CommandLine cli("auvrl config-doc",
@@ -314,6 +338,8 @@ const Subcommand kSubcommands[] = {
     {"eval",
      "evaluate a policy or the PID baseline on test1/test2/fault/current/suite or a mission",
      run_eval},
+    {"finetune", "fine-tune a trained run's policy again and evaluate it (see --help)",
+     run_finetune_command},
     {"fastest", "search open-loop commands for the soonest arrival the vehicle allows",
      run_fastest},
     {"export", "write a policy as a C99 header or an ONNX model (docs/export.md)", run_export},

@@ -46,6 +46,8 @@ void FinetuneConfig::validate() const {
           "smoothness_weight must be >= 0");
   require(integration_substeps >= 0, "integration_substeps must be >= 0");
   require(threads >= 0, "threads must be >= 0");
+  require(randomised_fraction >= 0 && randomised_fraction <= 1,
+          "randomised_fraction must be in [0, 1]");
 }
 
 std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
@@ -58,15 +60,27 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   std::vector<FinetuneEpisode> episodes;
   const int turned =
       static_cast<int>(std::lround(config.random_heading_fraction * config.episodes));
+  const int randomised =
+      static_cast<int>(std::lround(config.randomised_fraction * config.episodes));
+  // The conditions' own stream: turning them on changes no way-point or heading.
+  std::seed_seq conditions_seq{static_cast<std::uint32_t>(seed),
+                               static_cast<std::uint32_t>(seed >> 32), 0xF17E7u, 0xC0D1u};
+  std::mt19937_64 conditions_rng(conditions_seq);
+  const auto spread = [&](int k, int i) {
+    return k > 0 && (i * k) / config.episodes != ((i + 1) * k) / config.episodes;
+  };
   for (int i = 0; i < config.episodes; ++i) {
     FinetuneEpisode e;
     e.goal_ned_m = task::sample_goal(task, rng);
     e.start.position_ned_m = task.start_position_ned_m;
     e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
     // Spread the turned starts evenly through the list.
-    if (turned > 0 && (i * turned) / config.episodes != ((i + 1) * turned) / config.episodes) {
+    if (spread(turned, i)) {
       e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
     }
+    const task::EpisodeConditions conditions =
+        task::sample_conditions(task.randomise, task.num_thrusters, conditions_rng);
+    if (spread(randomised, i)) agent::apply_conditions(conditions, e.start);
     e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
     episodes.push_back(e);
   }

@@ -14,7 +14,8 @@
 //
 // The objective's way-points are drawn from the task's goal region with a stream of their own
 // (never the evaluation's suite nor the launcher's validation way-points), from the task's
-// fixed start, a fraction of them facing a random heading (as test2 does).
+// fixed start, a fraction of them facing a random heading (as test2 does), a fraction under the
+// conditions the task's randomisation draws for training.
 #pragma once
 
 #include <Eigen/Core>
@@ -38,6 +39,10 @@ struct FinetuneConfig {
   double learning_rate = 0.01;  ///< Adam's step on the rank-weighted direction
   int episodes = 24;            ///< way-points the objective averages over (fixed for the run)
   double random_heading_fraction = 0.25;  ///< of them, starting at a random heading
+  /// Of them, this share (spread through the list) also gets the conditions the task's
+  /// randomisation (task.randomise) draws for training episodes: faults, currents, sensor noise,
+  /// a wrong model; from the fine-tuning's own stream. 0: the vehicle file's, in still water.
+  double randomised_fraction = 0.0;
   /// Objective of one way-point, s: the time to within the reach radius (interpolated
   /// between control steps, so that braking a little later counts before it gains a whole
   /// step) plus hold_weight times the mean distance over the arrival step and the hold_steps

@@ -234,10 +234,10 @@ TEST_F(ActorDemonstrations, RandomisedEpisodesReachTheSimulatorAndLeaveTheGoalsA
   }
 }
 
-// The paper and fast presets randomise nothing (the paper's stays literal); robust.yaml turns
-// every kind on.
+// The paper, fast and smooth presets randomise nothing (the paper's stays literal); robust.yaml
+// turns every kind on.
 TEST(ActorConfigFile, OnlyTheRobustPresetRandomisesEpisodes) {
-  for (const std::string preset : {"paper", "fast", "robust"}) {
+  for (const std::string preset : {"paper", "fast", "smooth", "robust"}) {
     ActorNodeConfig c;
     read_actor_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml", c);
     const task::EpisodeRandomisation& r = c.task.randomise;

@@ -1,6 +1,7 @@
 // run_episode's end conditions against scripted vehicles and a scripted controller: time limit
 // (a cut-off), reaching, leaving beta_max, flipping, a blow-up, a silent simulator; and what
-// it reports on the way (transitions, trajectory, reach time, hold error).
+// it reports on the way (transitions, trajectory, reach time, hold error, from the true position
+// where the link knows it).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -158,6 +159,27 @@ TEST(RunEpisode, RunFullTimeKeepsGoingAfterReachingAndMeasuresTheHold) {
   EXPECT_EQ(r.trajectory.size(), 50u);
   EXPECT_NEAR(r.summary.mean_error_after_reach_m, 0.4, 1e-9);
   EXPECT_NEAR(r.summary.final_distance_m, 0.4, 1e-9);
+}
+
+// Where the link knows the true position (a simulator in process, with sensor noise), the
+// figures use it; the controller and the reward still get the reported observation.
+TEST(RunEpisode, FiguresUseTheTruePositionWhereTheLinkKnowsIt) {
+  const task::TaskConfig task = small_task();
+  // Truly 0.4 m short of the goal from step 5 on; the report says 0.7 m beyond it (noise).
+  ScriptedLink noisy(6, [](int step, task::Observation& o, VehicleReport& r) {
+    const double x = std::min(0.52 * step, 2.6);
+    r.true_position_ned_m = Eigen::Vector3d(x, o.position_ned_m.y(), o.position_ned_m.z());
+    o.position_ned_m.x() = step >= 5 ? 3.7 : x;
+  });
+  ConstantController controller(0.0f, task.state_dim());
+  EpisodeOptions options = goal_north(3.0);
+  options.run_full_time = true;
+  const EpisodeRun r = run(task, noisy, controller, options);
+  EXPECT_NEAR(r.summary.time_to_reach_s, 0.5, 1e-12);
+  EXPECT_NEAR(r.summary.mean_error_after_reach_m, 0.4, 1e-9);
+  EXPECT_NEAR(r.summary.final_distance_m, 0.4, 1e-9);
+  EXPECT_NEAR(r.trajectory.back().distance_m, 0.4, 1e-9);
+  EXPECT_NEAR(r.trajectory.back().observation.position_ned_m.x(), 3.7, 1e-12);  // as reported
 }
 
 TEST(RunEpisode, StepsAfterReachEndsTheFullTimeRunThatManyStepsAfterArriving) {

@@ -12,6 +12,7 @@
 #include "child_process.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/pipeline.hpp"
+#include "launcher/refinetune.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/training.hpp"
 
@@ -87,6 +88,34 @@ TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
     EXPECT_TRUE(fs::exists(tmp / "run" / file)) << file;
   }
   EXPECT_NE(out.str().find("robustness suite: 500 episodes each"), std::string::npos) << out.str();
+}
+
+// auvrl finetune: a trained run's policy fine-tuned again into a directory of its own and
+// evaluated there; an output directory in use is refused.
+TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  prepare_run_directory(options);
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", tmp / "run" / "policy.nn");
+  RefinetuneOptions o;
+  o.run_dir = options.run_dir;
+  o.out_dir = (tmp / "again").string();
+  o.iterations = 2;
+  std::ostringstream out;
+  ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  EXPECT_NE(out.str().find("fine-tuning " + options.run_dir + "/policy.nn"), std::string::npos)
+      << out.str();
+  for (const char* file : {"config.yaml", "finetune.csv", "eval/selected_policy.txt",
+                           "eval/robustness_comparison.md"}) {
+    EXPECT_TRUE(fs::exists(tmp / "again" / file)) << file;
+  }
+  std::ostringstream again;
+  EXPECT_THROW(refinetune(o, again), std::invalid_argument);
+  o.out_dir = (tmp / "other").string();
+  o.run_dir = (tmp / "none").string();
+  EXPECT_THROW(refinetune(o, again), std::invalid_argument);
 }
 
 class RolesTest : public ::testing::Test {

@@ -76,9 +76,9 @@ TEST(LearnerSection, ReadsTheSmoothnessTermsAndRefusesNegativeWeightsNamingTheKe
   }
 }
 
-// The smoothness terms are off in the paper and fast presets, on in robust.yaml.
+// The smoothness terms are off in the paper, fast and smooth presets, on in robust.yaml.
 TEST(LearnerSection, OnlyTheRobustPresetSmoothsTheCommands) {
-  for (const std::string preset : {"paper", "fast", "robust"}) {
+  for (const std::string preset : {"paper", "fast", "smooth", "robust"}) {
     LearnerNodeConfig config;
     read_learner_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml",
                              config);

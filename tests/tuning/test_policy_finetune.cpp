@@ -64,6 +64,35 @@ TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
   for (const auto& e : a) EXPECT_NE(e.goal_ned_m, first_suite_goal);
 }
 
+// randomised_fraction: that share of the way-points gets the task's randomised conditions (every
+// kind on here, so each randomised episode gets a fault), the way-points and headings unchanged.
+TEST(FinetuneEpisodes, RandomiseTheFractionAskedWithoutMovingTheWayPoints) {
+  FinetuneConfig c;
+  c.episodes = 20;
+  task::TaskConfig t = fast_task();
+  t.randomise.fault_probability = 1.0;
+  t.randomise.model_probability = 1.0;
+  const auto still = finetune_episodes(t, c, 7);
+  c.randomised_fraction = 0.5;
+  const auto a = finetune_episodes(t, c, 7);
+  const auto b = finetune_episodes(t, c, 7);
+  int randomised = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].goal_ned_m, still[i].goal_ned_m);
+    EXPECT_EQ(a[i].start.euler_rpy_rad, still[i].start.euler_rpy_rad);
+    EXPECT_EQ(a[i].start.thruster_efficiency, b[i].start.thruster_efficiency);
+    EXPECT_TRUE(still[i].start.thruster_efficiency.empty());
+    EXPECT_TRUE(still[i].start.model_variation.is_identity());
+    if (!a[i].start.thruster_efficiency.empty()) {
+      ++randomised;
+      EXPECT_FALSE(a[i].start.model_variation.is_identity());
+    }
+  }
+  EXPECT_EQ(randomised, 10);
+  c.randomised_fraction = 1.5;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
 TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   const task::TaskConfig t = fast_task();
   FinetuneEpisode e;
