@@ -54,7 +54,13 @@ VehicleModel vary_model(const VehicleModel& nominal, const ModelVariation& v) {
       model.thruster_dynamics.lag_time_constant_s = v.thruster_lag_time_constant_s;
     }
   }
-  finalize_vehicle_model(model);
+  try {
+    finalize_vehicle_model(model);
+  } catch (const VehicleFileError& e) {
+    // Scales within range can still make a model unusable (a mass of 1e-300 kg weighs 0 N).
+    throw std::invalid_argument(
+        fmt::format("model variation: the varied model is not usable: {}", e.what()));
+  }
   return model;
 }
 

@@ -27,7 +27,8 @@ struct ModelVariation {
 
 /// The nominal model with the variation applied, its derived matrices recomputed (its name,
 /// file and CRC stay the file's: it is the same vehicle, differently wrong). Throws
-/// std::invalid_argument naming the field for a non-positive scale or a non-finite value.
+/// std::invalid_argument naming the field for a non-positive scale or a non-finite value, and
+/// for a variation that leaves the model unusable (e.g. a mass scale so small the weight is 0).
 VehicleModel vary_model(const VehicleModel& nominal, const ModelVariation& variation);
 
 }  // namespace auvrl::sim

@@ -77,6 +77,12 @@ TEST(ModelVariation, BadValuesAreRefusedNamingTheField) {
   v = ModelVariation{};
   v.extra_buoyancy_n = std::nan("");
   EXPECT_THROW(vary_model(nominal, v), std::invalid_argument);
+  // In range, but the model it leaves weighs nothing (found by fuzz_sim_server).
+  v = ModelVariation{};
+  v.mass_scale = 1e-320;
+  EXPECT_THROW(vary_model(nominal, v), std::invalid_argument);
+  v.mass_scale = 1e308;
+  EXPECT_THROW(vary_model(nominal, v), std::invalid_argument);
 }
 
 }  // namespace
