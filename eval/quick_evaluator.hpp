@@ -20,10 +20,6 @@ constexpr std::uint64_t kValidationSeed = 0x7A11DA7E;
 /// PID baseline at construction and by each candidate policy on demand. With turned > 0, that
 /// many more way-points start facing a random heading (as test2 does; the fine-tuning's
 /// choice, which must not trade the turn for speed).
-/// The quick evaluation that keeps the best policy: the validation way-points, run once by the
-/// PID baseline at construction and by each candidate policy on demand. With turned > 0, that
-/// many more way-points start facing a random heading (as test2 does; the fine-tuning's
-/// choice, which must not trade the turn for speed).
 class QuickEvaluator {
  public:
   QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task, int suite_episodes,
