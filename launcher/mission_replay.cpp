@@ -27,6 +27,7 @@
 #include "launcher/run_directory.hpp"
 #include "launcher/supervisor.hpp"
 #include "logger/event_log.hpp"
+#include "logger/log_tools.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace auvrl::launcher {
@@ -42,10 +43,6 @@ constexpr int kReplayStopped = 130;  ///< exit code: Ctrl-C or SIGTERM
 /// The files of a run that a replay writes again and compares.
 const char* const kComparedFiles[] = {"trajectory.csv", "waypoints.csv", "events.csv",
                                       "vehicle.csv"};
-
-std::string absolute(const std::string& path) {
-  return path.empty() ? path : fs::absolute(path).lexically_normal().string();
-}
 
 std::vector<std::string> read_lines(const std::string& path) {
   std::vector<std::string> lines;
@@ -65,25 +62,14 @@ std::vector<std::string> run_logs(const std::string& run_dir) {
   return files;
 }
 
-/// The vehicle file a run named in its vehicle.csv (the second cell of the first row, a quoted
-/// cell unquoted), if any: RUN/vehicle.yaml is a copy of it.
+/// The vehicle file a run named in its vehicle.csv (the second cell of the first row), if any:
+/// RUN/vehicle.yaml is a copy of it.
 std::optional<std::string> vehicle_file_named_in(const std::string& run_dir) {
   const std::vector<std::string> lines = read_lines((fs::path(run_dir) / "vehicle.csv").string());
   if (lines.size() < 2) return std::nullopt;
-  const std::string& row = lines[1];
-  std::size_t i = row.find(',');
-  if (i == std::string::npos) return std::nullopt;
-  std::string cell;
-  if (++i < row.size() && row[i] == '"') {  // csv::quote: "text" with "" for a quote
-    for (++i; i < row.size(); ++i) {
-      if (row[i] == '"' && (i + 1 >= row.size() || row[i + 1] != '"')) return cell;
-      if (row[i] == '"') ++i;
-      cell += row[i];
-    }
-    return std::nullopt;  // no closing quote
-  }
-  cell = row.substr(i, row.find(',', i) - i);
-  return cell;
+  const std::vector<std::string> cells = logger::split_csv_line(lines[1]);
+  if (cells.size() < 2) return std::nullopt;
+  return cells[1];
 }
 
 }  // namespace
@@ -108,7 +94,7 @@ std::string compare_files(const std::string& original_path, const std::string& r
 void prepare_mission_replay(MissionReplayOptions& o) {
   if (o.run_dir.empty()) throw std::invalid_argument("--run-dir RUN is required");
   if (!(o.speed > 0)) throw std::invalid_argument("--speed must be > 0");
-  o.run_dir = absolute(o.run_dir);
+  o.run_dir = absolute_path(o.run_dir);
   run_logs(o.run_dir);
   if (!fs::exists(o.player)) {
     throw std::invalid_argument(o.player + " not found (Debian: apt install liblcm-bin)");
@@ -128,11 +114,10 @@ void prepare_mission_replay(MissionReplayOptions& o) {
   if (o.out_dir.empty()) {
     o.out_dir = (fs::path(o.run_dir) / ("replay-" + run_timestamp())).string();
   }
-  o.out_dir = absolute(o.out_dir);
-  o.mission_path = absolute(o.mission_path);
-  o.vehicle_path = absolute(o.vehicle_path);
-  std::error_code ec;
-  if (fs::exists(o.out_dir) && !fs::is_empty(o.out_dir, ec)) {
+  o.out_dir = absolute_path(o.out_dir);
+  o.mission_path = absolute_path(o.mission_path);
+  o.vehicle_path = absolute_path(o.vehicle_path);
+  if (directory_in_use(o.out_dir)) {
     throw std::invalid_argument(o.out_dir +
                                 " already exists and is not empty: a replay never overwrites");
   }
@@ -316,13 +301,8 @@ void ReplaySession::write_report(
   for (const MissionRunEvent& e : event_log_.events()) md << "- " << e.text << "\n";
   md << "\n## Compared with the run\n\n| file | |\n|---|---|\n";
   for (const auto& [name, result] : comparison) md << "| " << name << " | " << result << " |\n";
-  md << "\n## Plots\n\n";
-  if (plots_note.empty()) {
-    md << "![3-D path through the way-points](plots/mission_3d.png)\n\n"
-       << "![thruster outputs](plots/mission_thrusters.png)\n";
-  } else {
-    md << plots_note << "\n";
-  }
+  md << "\n";
+  write_plots_section(md, plots_note);
   md.flush();
   if (!md) throw std::runtime_error("cannot write " + path);
 }

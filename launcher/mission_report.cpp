@@ -73,17 +73,17 @@ void write_events(std::ostream& md, const MissionRunSummary& s) {
   md << "\n";
 }
 
-void write_plots(std::ostream& md, const MissionRunSummary& s) {
+}  // namespace
+
+void write_plots_section(std::ostream& md, const std::string& plots_note) {
   md << "## Plots\n\n";
-  if (!s.plots_note.empty()) {
-    md << s.plots_note << "\n\n";
+  if (!plots_note.empty()) {
+    md << plots_note << "\n\n";
     return;
   }
   md << "![3-D path through the way-points](plots/mission_3d.png)\n\n"
      << "![thruster outputs](plots/mission_thrusters.png)\n\n";
 }
-
-}  // namespace
 
 double achieved_realtime_factor(const MissionRunSummary& s) {
   return s.mission_wall_s > 0 ? s.vehicle_time_s / s.mission_wall_s : 0.0;
@@ -178,7 +178,7 @@ void write_mission_report(const MissionRunOptions& o, const agent::Mission& miss
     md << line << "\n";
   }
   md << "```\n\n";
-  write_plots(md, s);
+  write_plots_section(md, s.plots_note);
   md << "## Files\n\n"
      << "trajectory.csv (every state from the mission start, eval's trajectory format), "
         "waypoints.csv, vehicle.csv, logs/ (LCM event logs), processes/ (each process's "

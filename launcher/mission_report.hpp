@@ -53,6 +53,9 @@ std::vector<eval::MissionWaypointRow> write_mission_record(const std::string& di
 std::string draw_mission_plots(const std::string& source_dir, const std::string& dir,
                                const std::string& run_name);
 
+/// The report's "## Plots" section: the two plots, or plots_note (why there are none).
+void write_plots_section(std::ostream& md, const std::string& plots_note);
+
 /// The auv_controller lines of its log (processes/controller.log): its start, every event and
 /// way-point with its vehicle time, its end.
 std::vector<std::string> controller_event_lines(const std::string& log_path);

@@ -47,10 +47,6 @@ constexpr double kLoggerGraceS = 10.0;
 /// Mission times are differences of vehicle clocks: 6.0 may come out as 5.9999999.
 constexpr double kTimeToleranceS = 1e-6;
 
-std::string absolute(const std::string& path) {
-  return path.empty() ? path : fs::absolute(path).lexically_normal().string();
-}
-
 /// The mission's name as a file name: letters, digits, '-', '_' and '.' kept, others '_'.
 std::string file_name_part(const std::string& name) {
   std::string out = name;
@@ -87,9 +83,9 @@ void check_mission_run(MissionRunOptions& o) {
   if (o.vehicle_path.empty()) {
     o.vehicle_path = mission.vehicle_path.empty() ? default_vehicle_file() : mission.vehicle_path;
   }
-  o.mission_path = absolute(o.mission_path);
-  o.vehicle_path = absolute(o.vehicle_path);
-  o.policy_path = absolute(o.policy_path);
+  o.mission_path = absolute_path(o.mission_path);
+  o.vehicle_path = absolute_path(o.vehicle_path);
+  o.policy_path = absolute_path(o.policy_path);
   // auv_controller's own checks (the policy fits the vehicle, the PID has gains).
   const agent::ControllerSetup setup =
       agent::load_controller_setup(controller_options(o, o.mission_path));
@@ -107,7 +103,7 @@ void check_mission_run(MissionRunOptions& o) {
                  ("mission-" + file_name_part(mission.name) + "-" + run_timestamp()))
                     .string();
   }
-  o.run_dir = absolute(o.run_dir);
+  o.run_dir = absolute_path(o.run_dir);
 }
 
 /// README.txt: what each file of a mission run directory holds.
@@ -135,8 +131,7 @@ void write_mission_readme(const MissionRunOptions& o) {
 void prepare_mission_run(MissionRunOptions& o) {
   check_mission_run(o);
   const fs::path dir = o.run_dir;
-  std::error_code ec;
-  if (fs::exists(dir) && !fs::is_empty(dir, ec)) {
+  if (directory_in_use(o.run_dir)) {
     throw std::runtime_error(o.run_dir +
                              " already exists and is not empty: a run directory is never reused");
   }

@@ -4,9 +4,10 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "launcher/launcher.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/run_config.hpp"
-#include "sim/vehicle_model.hpp"
+#include "launcher/run_directory.hpp"
 
 namespace auvrl::launcher {
 
@@ -31,19 +32,18 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   }
   const std::string policy = o.policy_path.empty() ? run_policy(o.run_dir) : o.policy_path;
   if (!fs::exists(policy)) throw std::invalid_argument(policy + " not found");
-  std::error_code ec;
-  if (fs::exists(o.out_dir) && !fs::is_empty(o.out_dir, ec)) {
+  if (directory_in_use(o.out_dir)) {
     throw std::invalid_argument(o.out_dir + " already exists and is not empty");
   }
-  RunContext ctx;
-  ctx.options.source_dir = o.source_dir;
-  ctx.run_dir = o.out_dir;
-  ctx.rc = read_run_config(run_config.string());
+  // The run's configuration and vehicle as `auvrl train` loads them, then this directory's.
+  TrainOptions train;
+  train.run_dir = o.run_dir;
+  train.source_dir = o.source_dir;
+  train.seed = o.seed;
+  RunContext ctx = load_run_context(train);
   if (!o.config_path.empty()) ctx.rc.finetune = read_run_config(o.config_path).finetune;
   if (o.iterations >= 0) ctx.rc.finetune.iterations = o.iterations;
-  if (o.seed >= 0) ctx.rc.run.seed = static_cast<std::uint64_t>(o.seed);
-  ctx.model = sim::load_vehicle_file(ctx.rc.vehicle_path);
-  task::apply_vehicle(ctx.model.facts(), ctx.rc.task);
+  ctx.run_dir = o.out_dir;
   fs::create_directories(fs::path(o.out_dir) / "processes");
   ctx.config_path = (fs::path(o.out_dir) / "config.yaml").string();
   fs::copy_file(run_config, ctx.config_path);

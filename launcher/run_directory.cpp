@@ -15,6 +15,15 @@ namespace auvrl::launcher {
 
 namespace fs = std::filesystem;
 
+std::string absolute_path(const std::string& path) {
+  return path.empty() ? path : fs::absolute(path).lexically_normal().string();
+}
+
+bool directory_in_use(const std::string& dir) {
+  std::error_code ec;
+  return fs::exists(dir) && !fs::is_empty(dir, ec);
+}
+
 std::string run_timestamp() {
   const std::time_t now = std::time(nullptr);
   char text[32];

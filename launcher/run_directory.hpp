@@ -13,6 +13,12 @@ struct TrainOptions;
 /// what is wrong.
 std::string prepare_run_directory(TrainOptions& options);
 
+/// The path made absolute and normal ("" stays "").
+std::string absolute_path(const std::string& path);
+
+/// Whether dir exists and holds anything: an output directory is never reused.
+bool directory_in_use(const std::string& dir);
+
 /// The local time as run directories name it: 20250131-142501.
 std::string run_timestamp();
 

@@ -32,21 +32,14 @@ try:
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
 
-    from plot_run import set_3d_limits  # noqa: E402  (beside this script: one 3-D framing)
+    # Beside this script: one 3-D framing, one reading of a CSV cell.
+    from plot_run import number, set_3d_limits  # noqa: E402
 except ImportError as e:  # a clear note, not a traceback: auvrl run reports it
     print(f"plot_mission: cannot import {e.name}: apt install python3-matplotlib python3-numpy",
           file=sys.stderr)
     sys.exit(3)
 
 DPI = 100
-
-
-def number(text):
-    """A float from a CSV cell; NaN for an empty or unreadable one."""
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def read_rows(path):

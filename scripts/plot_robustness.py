@@ -26,6 +26,8 @@ try:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: E402
     import numpy as np  # noqa: E402
+
+    from plot_run import number  # noqa: E402  (beside this script: one reading of a CSV cell)
 except ImportError as e:
     print(f"plot_robustness: cannot import {e.name}: apt install python3-matplotlib "
           "python3-numpy", file=sys.stderr)
@@ -36,14 +38,6 @@ HOLD_MARGIN_M = 0.05  # the bar: hold error within the PID's + this
 SMOOTHNESS_RATIO = 2.0  # the bar: smoothness at most this times the PID's
 COLORS = {"policy": "tab:blue", "pid": "tab:orange"}
 LABELS = {"policy": "learned policy", "pid": "PID baseline"}
-
-
-def number(text):
-    """A float from a CSV cell; NaN for an empty or unreadable one."""
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
 
 
 def read_groups(path):

@@ -93,6 +93,14 @@ def parse_float_or_empty(s):
     return math.nan if s.strip() == "" else float(s)
 
 
+def number(text):
+    """A float from a CSV cell; NaN for an empty or unreadable one."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
 def parse_bool(s):
     v = s.strip().lower()
     if v in ("1", "true", "yes"):

@@ -93,13 +93,8 @@ std::string model_variation_from_message(const auvrl_lcm::vehicle_reset_t& msg,
   const double values[] = {msg.model_quadratic_damping_scale, msg.model_added_mass_scale,
                            msg.model_mass_scale, msg.model_thruster_lag_time_constant_s,
                            msg.model_extra_buoyancy_n};
+  // Ranges are vary_model's to check (set_variation counts a refusal as out of range).
   if (!all_finite(values, std::size(values))) return "non-finite model variation";
-  if (!(msg.model_quadratic_damping_scale > 0)) {
-    return "vehicle_reset_t.model_quadratic_damping_scale must be > 0";
-  }
-  if (!(msg.model_added_mass_scale > 0))
-    return "vehicle_reset_t.model_added_mass_scale must be > 0";
-  if (!(msg.model_mass_scale > 0)) return "vehicle_reset_t.model_mass_scale must be > 0";
   out.quadratic_damping_scale = msg.model_quadratic_damping_scale;
   out.added_mass_scale = msg.model_added_mass_scale;
   out.mass_scale = msg.model_mass_scale;
