@@ -32,9 +32,14 @@ using Clock = std::chrono::steady_clock;
 class ActorNode::ExploringController final : public Controller {
  public:
   explicit ExploringController(ActorNode& node) : node_(node) {}
+  void reset() override { step_ = 0; }
   void act(const task::Observation& obs, const Eigen::Vector3d& goal,
            const task::StateVector& state, task::ActionVector& action) override {
-    node_.refresh_policy();
+    if (node_.config_.reproducible) {
+      node_.use_round_weights(step_++);
+    } else {
+      node_.refresh_policy();
+    }
     if (PolicyController* policy = node_.policy_.policy()) {
       policy->act(obs, goal, state, action);
     } else {
@@ -45,6 +50,7 @@ class ActorNode::ExploringController final : public Controller {
 
  private:
   ActorNode& node_;
+  std::int64_t step_ = 0;  ///< of the episode (the reproducible mode's round)
 };
 
 ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, std::ostream& log,
@@ -54,7 +60,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
       log_(log),
       link_(make_lockstep_link(lockstep_transport ? *lockstep_transport : transport,
                                config_.vehicle_id, config_.vehicle, config_.lockstep)),
-      weights_(transport, channels::kPolicyWeights, 8),
+
       controller_(std::make_unique<ExploringController>(*this)),
       noise_(config_.noise, config_.task.num_thrusters, config_.noise_sigma, config_.noise_theta,
              config_.seed * 0x9E3779B97F4A7C15ull + 1),
@@ -79,14 +85,32 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
   }
   if (!config_.expert_labels) config_.expert.reset();
   last_weights_ = last_request_ = Clock::now() - std::chrono::hours(1);
+  if (config_.reproducible) {
+    if (config_.round_weights_every_steps < 1) {
+      throw std::invalid_argument("round_weights_every_steps must be >= 1");
+    }
+    // Every weights message counts (each round's indices in turn), not only the newest.
+    weights_subscription_ = transport::subscribe<auvrl_lcm::policy_weights_t>(
+        transport_, channels::kPolicyWeights,
+        [this](const std::string&, const auvrl_lcm::policy_weights_t& m) {
+          weights_queue_.push_back(m);
+        },
+        nullptr, 256);
+    round_progress_ = round_request_ = Clock::now();
+  } else {
+    weights_ = std::make_unique<transport::Latest<auvrl_lcm::policy_weights_t>>(
+        transport_, channels::kPolicyWeights, 8);
+  }
 }
 
-ActorNode::~ActorNode() = default;
+ActorNode::~ActorNode() {
+  if (weights_subscription_ >= 0) transport_.unsubscribe(weights_subscription_);
+}
 
 void ActorNode::refresh_policy() {
   // Weights supersede each other: drain what is pending, keep only the newest.
   transport_.drain();
-  if (auto msg = weights_.take()) {
+  if (auto msg = weights_->take()) {
     std::string error;
     switch (policy_.apply(*msg, error)) {
       case WeightsOutcome::kApplied:
@@ -116,6 +140,7 @@ void ActorNode::refresh_policy() {
     req.utime = transport::now_utime();
     req.actor_id = config_.actor_id;
     req.have_version = policy_.version();
+    req.want_round = -1;
     transport::publish(transport_, channels::kWeightsRequest, req);
     last_request_ = now;
     ++counters_.weights_requests;
@@ -139,11 +164,35 @@ void ActorNode::wait_for_learner() {
 }
 
 EpisodeSummary ActorNode::run_one_episode() {
+  if (config_.reproducible) return run_round();
   wait_for_learner();
   refresh_policy();
   ++episode_id_;
+  std::vector<Transition> transitions;
+  Eigen::Vector3d goal;
+  const EpisodeSummary summary = play_episode(transitions, goal);
+  if (!discarded(summary)) {
+    for (const auto& msg : experience_messages(transitions, goal)) {
+      transport::publish(transport_, channels::kExperience, msg);
+      counters_.transitions_sent += msg.num_transitions;
+      ++counters_.batches_sent;
+    }
+  }
+  if (!last_was_demonstration_) send_report(summary, goal);
+  return summary;
+}
+
+bool ActorNode::discarded(const EpisodeSummary& summary) {
+  // A numerical blow-up or a lost simulator: none of the episode is trusted.
+  return summary.end_reason == task::EndReason::kBlowUp ||
+         summary.end_reason == task::EndReason::kSimTimeout;
+}
+
+EpisodeSummary ActorNode::play_episode(std::vector<Transition>& transitions,
+                                       Eigen::Vector3d& goal) {
   EpisodeOptions options;
   options.goal_ned_m = task::sample_goal(config_.task, goal_rng_);
+  goal = options.goal_ned_m;
   options.beta_m = policy_.beta_m();
   const task::StartState start = task::sample_start(config_.task, start_rng_);
   options.start.position_ned_m = start.position_ned_m;
@@ -160,7 +209,7 @@ EpisodeSummary ActorNode::run_one_episode() {
   // Drawn every episode, so the stream does not depend on the fraction's history.
   last_was_demonstration_ = draw::unit(demonstration_rng_) < config_.demonstration_fraction;
   Controller& controller = last_was_demonstration_ ? *config_.demonstrator : *controller_;
-  std::vector<Transition> transitions;
+  transitions.clear();
   transitions.reserve(static_cast<std::size_t>(config_.task.max_steps));
   options.on_transition = [&transitions](const Transition& t) { transitions.push_back(t); };
 
@@ -168,28 +217,22 @@ EpisodeSummary ActorNode::run_one_episode() {
   ++counters_.episodes;
   if (last_was_demonstration_) ++counters_.demonstrations;
   counters_.steps += summary.length_steps;
-  if (summary.end_reason == task::EndReason::kBlowUp ||
-      summary.end_reason == task::EndReason::kSimTimeout) {
-    // A numerical blow-up or a lost simulator: none of this episode is trusted.
-    ++counters_.episodes_discarded;
-  } else {
-    send_experience(transitions, options.goal_ned_m);
-  }
-  if (!last_was_demonstration_) send_report(summary, options.goal_ned_m);
+  if (discarded(summary)) ++counters_.episodes_discarded;
   return summary;
 }
 
-void ActorNode::send_experience(const std::vector<Transition>& transitions,
-                                const Eigen::Vector3d& goal) {
+std::vector<auvrl_lcm::experience_batch_t> ActorNode::experience_messages(
+    const std::vector<Transition>& transitions, const Eigen::Vector3d& goal) {
   const int state_dim = config_.task.state_dim();
   const int action_dim = config_.task.num_thrusters;
   const std::vector<float> goal_row = {static_cast<float>(goal[0]), static_cast<float>(goal[1]),
                                        static_cast<float>(goal[2])};
+  std::vector<auvrl_lcm::experience_batch_t> out;
   for (std::size_t begin = 0; begin < transitions.size();
        begin += static_cast<std::size_t>(config_.max_transitions_per_message)) {
     const std::size_t end = std::min(
         transitions.size(), begin + static_cast<std::size_t>(config_.max_transitions_per_message));
-    auvrl_lcm::experience_batch_t msg;
+    auvrl_lcm::experience_batch_t msg{};
     msg.utime = transport::now_utime();
     msg.actor_id = config_.actor_id;
     msg.batch_seq = ++batch_seq_;
@@ -197,6 +240,7 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
     msg.state_dim = state_dim;
     msg.action_dim = action_dim;
     msg.num_transitions = static_cast<std::int32_t>(end - begin);
+    msg.round = -1;
     msg.expert_rows = config_.expert ? msg.num_transitions : 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Transition& t = transitions[i];
@@ -216,10 +260,9 @@ void ActorNode::send_experience(const std::vector<Transition>& transitions,
                                         t.expert_action.data() + action_dim);
       }
     }
-    transport::publish(transport_, channels::kExperience, msg);
-    counters_.transitions_sent += msg.num_transitions;
-    ++counters_.batches_sent;
+    out.push_back(std::move(msg));
   }
+  return out;
 }
 
 void ActorNode::send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal) {

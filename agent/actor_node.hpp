@@ -4,8 +4,12 @@
 #pragma once
 
 #include <auvrl_lcm/policy_weights_t.hpp>
+#include <auvrl_lcm/experience_batch_t.hpp>
 #include <chrono>
 #include <cstdint>
+#include <deque>
+#include <map>
+#include <vector>
 #include <memory>
 #include <ostream>
 #include <random>
@@ -63,6 +67,18 @@ struct ActorNodeConfig {
   /// builds one.
   bool expert_labels = false;
   std::shared_ptr<Controller> expert;  ///< required when expert_labels
+
+  /// Reproducible mode (common/round_schedule.hpp): one episode per round, numbered by the
+  /// learner; every random draw of round r comes from (seed, r); at step j of round r the actor
+  /// acts with the learner's weights of round r - 1 at the index the schedule fixes, waiting for
+  /// them if need be. A restarted actor, or one whose learner went back to a checkpoint, takes
+  /// up the round the learner awaits and computes it again, the same.
+  bool reproducible = false;
+  int round_weights_every_steps = 100;  ///< RoundSchedule::weights_every_steps
+  /// Reproducible mode: a round sent and not taken after this long is sent again, s.
+  double round_resend_s = 1.0;
+  /// Reproducible mode: weights waited for this long are asked for again, s.
+  double round_request_s = 0.2;
 };
 
 /// The keys of an `actor:` section (agent/actor_config.cpp).
@@ -80,6 +96,9 @@ struct ActorCounters {
   std::int64_t weights_rejected = 0;  ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
   double waited_s = 0.0;  ///< time spent waiting for the learner (flow control)
+  std::int64_t rounds_sent = 0;       ///< reproducible mode
+  std::int64_t rounds_abandoned = 0;  ///< reproducible mode: the learner had moved elsewhere
+  std::int64_t rounds_resent = 0;     ///< reproducible mode: sent again, not taken in time
 };
 
 /// The actor as a transport participant. Single-threaded.
@@ -94,14 +113,19 @@ class ActorNode {
   ActorNode& operator=(const ActorNode&) = delete;
 
   /// Runs one episode and reports it (a demonstration is not reported); returns its summary.
+  /// In the reproducible mode: the round the learner awaits (one episode); it returns an empty
+  /// summary (length 0) when training ended while it waited.
   EpisodeSummary run_one_episode();
+  /// Reproducible mode: the round being acted in or waited for (-100 before the learner is
+  /// heard).
+  std::int64_t round() const { return round_; }
   /// Whether the last episode run was a demonstration.
   bool last_was_demonstration() const { return last_was_demonstration_; }
   /// What the last episode's randomisation drew (task.randomise).
   const task::EpisodeConditions& last_conditions() const { return last_conditions_; }
 
   /// The learner said training is over.
-  bool training_done() const { return policy_.training_done(); }
+  bool training_done() const { return policy_.training_done() || learner_done_; }
   std::int64_t policy_version() const { return policy_.version(); }
   double beta_m() const { return policy_.beta_m(); }
   const ActorCounters& counters() const { return counters_; }
@@ -111,14 +135,22 @@ class ActorNode {
 
   /// Applies the newest weights that have arrived (drained, newest kept); asks when due.
   void refresh_policy();
-  void send_experience(const std::vector<Transition>& transitions, const Eigen::Vector3d& goal);
+  /// Draws the episode's way-point, start and conditions, runs it (transitions kept) and counts
+  /// it; goal receives the way-point.
+  EpisodeSummary play_episode(std::vector<Transition>& transitions, Eigen::Vector3d& goal);
+  /// Blow-up or simulator timeout: nothing of the episode goes to the learner.
+  static bool discarded(const EpisodeSummary& summary);
+  /// The experience messages of an episode (at most max_transitions_per_message each).
+  std::vector<auvrl_lcm::experience_batch_t> experience_messages(
+      const std::vector<Transition>& transitions, const Eigen::Vector3d& goal);
   void send_report(const EpisodeSummary& summary, const Eigen::Vector3d& goal);
 
   ActorNodeConfig config_;
   transport::Transport& transport_;
   std::ostream& log_;
   std::unique_ptr<VehicleLink> link_;
-  transport::Latest<auvrl_lcm::policy_weights_t> weights_;
+  /// The newest weights (asynchronous mode; the reproducible one queues them all).
+  std::unique_ptr<transport::Latest<auvrl_lcm::policy_weights_t>> weights_;
   std::unique_ptr<ExploringController> controller_;
   ExplorationNoise noise_;
   std::mt19937_64 goal_rng_;
@@ -131,6 +163,38 @@ class ActorNode {
   ActorCounters counters_;
   /// Waits (flow control) while the learner's backlog is above the configured limit.
   void wait_for_learner();
+
+  // Reproducible mode (agent/actor_rounds.cpp).
+  /// Thrown out of an episode when the learner no longer awaits its round.
+  struct RoundAbandoned {};
+  static constexpr std::int64_t kNoRound = -100;
+  /// Runs rounds until one is sent (or training ends while waiting).
+  EpisodeSummary run_round();
+  /// Draws every random stream of round (episode) r from the seed and r.
+  void seed_round(std::int64_t round);
+  /// Takes in the weights that arrived; follows the learner to the round it awaits.
+  void pump_weights();
+  void on_round_weights(const auvrl_lcm::policy_weights_t& msg);
+  /// Waits until round_ can start (the weights of round_ - 1, index 0, are held); false when
+  /// training ended first.
+  bool await_round_start();
+  /// Puts in place the weights for step `step` of the round, waiting for them if need be.
+  /// Throws RoundAbandoned when the learner moved on or went back.
+  void use_round_weights(std::int64_t step);
+  void request_round_weights(std::int64_t round, std::int32_t index);
+
+  std::int64_t round_ = kNoRound;
+  bool round_abandoned_ = false;
+  bool learner_done_ = false;
+  std::int64_t learner_round_ = kNoRound;  ///< the round of the newest weights heard
+  std::map<std::int32_t, auvrl_lcm::policy_weights_t> round_weights_;  ///< of round_ - 1
+  std::int32_t applied_index_ = -1;  ///< index of round_ - 1 in place (-1: none)
+  std::int64_t sent_round_ = kNoRound;
+  std::vector<auvrl_lcm::experience_batch_t> sent_;  ///< kept until the learner takes it
+  std::chrono::steady_clock::time_point round_progress_;
+  std::chrono::steady_clock::time_point round_request_;
+  std::deque<auvrl_lcm::policy_weights_t> weights_queue_;
+  transport::SubscriptionId weights_subscription_ = -1;
 
   /// The policy, its version (-1: none yet, noise alone), beta and the learner's backlog.
   PolicyReceiver policy_;

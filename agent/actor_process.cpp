@@ -45,6 +45,7 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
   while (!signals::stop_requested() && !node.training_done() &&
          (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
     const EpisodeSummary s = node.run_one_episode();
+    if (s.length_steps == 0 && node.training_done()) break;  // ended while it waited
     if (node.last_was_demonstration()) continue;  // the window is the policy's
     return_sum += s.episode_return;
     successes += s.success ? 1 : 0;
@@ -68,7 +69,12 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
   const auto& c = node.counters();
   log << "auv_actor " << config.actor_id << ": stopped after " << c.episodes << " episodes, "
       << c.steps << " steps, " << c.transitions_sent << " transitions sent, "
-      << c.episodes_discarded << " discarded\n";
+      << c.episodes_discarded << " discarded";
+  if (config.reproducible) {
+    log << ", " << c.rounds_sent << " rounds sent, " << c.rounds_resent << " sent again, "
+        << c.rounds_abandoned << " abandoned";
+  }
+  log << "\n";
 }
 
 void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions& options,

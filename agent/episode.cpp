@@ -25,6 +25,11 @@ ExplorationNoise::ExplorationNoise(Kind kind, int dim, double sigma, double thet
 
 void ExplorationNoise::reset() { state_.setZero(); }
 
+void ExplorationNoise::reseed(std::uint64_t seed) {
+  rng_.seed(seed);
+  state_.setZero();
+}
+
 void ExplorationNoise::apply(task::ActionVector& action) {
   if (kind_ == Kind::kNone) return;
   for (Eigen::Index i = 0; i < action.size(); ++i) {

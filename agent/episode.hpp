@@ -21,6 +21,8 @@ class ExplorationNoise {
   /// OU as in Lillicrap et al.: theta 0.15, sigma 0.2, dt 1 per step; Gaussian: N(0, sigma).
   ExplorationNoise(Kind kind, int dim, double sigma, double theta, std::uint64_t seed);
   void reset();  ///< start of an episode (OU state to zero)
+  /// Restarts the random stream from `seed` (and the OU state at zero).
+  void reseed(std::uint64_t seed);
   /// Adds noise to action in place and clips to [-1, 1].
   void apply(task::ActionVector& action);
   Kind kind() const { return kind_; }

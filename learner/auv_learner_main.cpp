@@ -45,6 +45,15 @@ int main(int argc, char** argv) {
   cmd.option("hidden", &options.hidden, "hidden sizes of both networks, e.g. 400-300");
   cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
   cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
+  cmd.flag("reproducible", &config.reproducible,
+           "reproducible mode: experience in rounds from exactly --max-actors actors, weights by "
+           "round, periods in updates (common/round_schedule.hpp)");
+  cmd.option("round-weights-every-steps", &config.round_weights_every_steps,
+             "reproducible mode: an actor's steps per weights index");
+  cmd.option("snapshot-dir", &config.snapshot_dir,
+             "reproducible mode: the actor network is written here every --snapshot-every-updates");
+  cmd.option("snapshot-every-updates", &config.snapshot_every_updates,
+             "reproducible mode: updates between snapshots (0: none)");
   cmd.flag("resume", &options.resume,
            "continue from the newest usable checkpoint in --checkpoint-dir");
   cmd.flag("keep-running", &options.keep_running, "keep serving after training is done");

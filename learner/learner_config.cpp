@@ -81,7 +81,11 @@ config::Table<LearnerNodeConfig> make_learner_table() {
   t.field("stats_period_s", &C::stats_period_s, "s", "period of LEARNER_STATS");
   t.field("max_episodes", &C::max_episodes, "episodes, 0: never", "end of training");
   t.field("max_updates", &C::max_updates, "updates, 0: never", "end of training");
-  t.field("checkpoint_period_s", &C::checkpoint_period_s, "s", "time between checkpoints");
+  t.field("checkpoint_period_s", &C::checkpoint_period_s, "s",
+          "time between checkpoints (asynchronous mode)");
+  t.field("checkpoint_every_updates", &C::checkpoint_every_updates, "updates, 0: only the last",
+          "updates between checkpoints (reproducible mode)")
+      .range(0);
   t.field("keep_checkpoints", &C::keep_checkpoints, "", "checkpoints kept");
   t.field("her", &C::her, "", "hindsight relabelling (future strategy) with the task's reward");
   t.field("her_k", &C::her_k, "", "HER: future goals per real one");

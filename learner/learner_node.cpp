@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <filesystem>
+
 #include <algorithm>
 #include <auvrl_lcm/policy_summary_t.hpp>
 #include <cmath>
@@ -33,7 +35,7 @@ bool all_finite(const std::vector<std::vector<float>>& rows) {
 
 /// Record of the learner's own state in a checkpoint (the algorithm and the buffer follow it).
 constexpr const char* kCheckpointMagic = "AUVRLCK";
-constexpr std::uint32_t kCheckpointVersion = 1;
+constexpr std::uint32_t kCheckpointVersion = 2;
 
 }  // namespace
 
@@ -66,6 +68,19 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
     her_ = std::make_unique<HindsightRelabeler>(config_.task, config_.her_k);
   }
   last_batch_seq_.assign(static_cast<std::size_t>(config_.max_actors), -1);
+  if (config_.reproducible) {
+    round_schedule_ = {config_.round_weights_every_steps, config_.max_actors,
+                       config_.updates_per_transition};
+    round_schedule_.validate();
+    if (config_.snapshot_every_updates < 0 || config_.checkpoint_every_updates < 0) {
+      throw std::invalid_argument("snapshot_every_updates and checkpoint_every_updates must be >= 0");
+    }
+    collector_ = std::make_unique<RoundCollector>(config_.max_actors);
+    // Round -1 has no experience: its only weights are the initial networks'.
+    round_weights_.begin(-1);
+    round_updates_owed_ = round_updates_done_ = 0;
+    record_round_weights(true);  // published at the first poll (broadcast_requested_)
+  }
 
   using transport::subscribe;
   subscriptions_.push_back(subscribe<auvrl_lcm::experience_batch_t>(
@@ -117,13 +132,10 @@ void LearnerNode::note_other_sizes(const auvrl_lcm::experience_batch_t& msg) {
       describe(config_.vehicle), task::to_string(config_.task.layout));
 }
 
-void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
-  ++counters_.batches_received;
-  if (msg.actor_id < 0 || msg.actor_id >= config_.max_actors) {
-    ++counters_.dropped_unknown_actor;
-    return;
-  }
+bool LearnerNode::sound_batch(const auvrl_lcm::experience_batch_t& msg) {
   const int n = msg.num_transitions;
+  // A round's only batch may be empty (its episodes gave no experience).
+  const bool empty_ok = config_.reproducible && n == 0 && msg.round_batches == 1;
   const auto rows_ok = [n](const auto& rows, int cols) {
     return static_cast<int>(rows.size()) == n &&
            std::all_of(rows.begin(), rows.end(),
@@ -131,12 +143,16 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
   };
   if (n >= 1 && n <= config_.max_transitions_per_batch) note_other_sizes(msg);
   if (msg.state_dim != config_.ddpg.state_dim || msg.action_dim != config_.ddpg.action_dim ||
-      n < 1 || n > config_.max_transitions_per_batch || !rows_ok(msg.states, msg.state_dim) ||
-      !rows_ok(msg.next_states, msg.state_dim) || !rows_ok(msg.actions, msg.action_dim) ||
-      !rows_ok(msg.achieved_position_ned_m, 3) || !rows_ok(msg.goal_ned_m, 3) ||
+      (n < 1 && !empty_ok) || n > config_.max_transitions_per_batch ||
+      !rows_ok(msg.states, msg.state_dim) || !rows_ok(msg.next_states, msg.state_dim) ||
+      !rows_ok(msg.actions, msg.action_dim) || !rows_ok(msg.achieved_position_ned_m, 3) ||
+      !rows_ok(msg.goal_ned_m, 3) ||
+      static_cast<int>(msg.rewards.size()) != n || static_cast<int>(msg.terminal.size()) != n ||
+      static_cast<int>(msg.episode_id.size()) != n ||
+      static_cast<int>(msg.step_index.size()) != n ||
       (msg.expert_rows != 0 && !rows_ok(msg.expert_actions, msg.action_dim))) {
     ++counters_.dropped_dims;
-    return;
+    return false;
   }
   const bool finite =
       all_finite(msg.states) && all_finite(msg.next_states) && all_finite(msg.actions) &&
@@ -149,35 +165,33 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
       return std::all_of(a.begin(), a.end(), [](float v) { return std::abs(v) <= 1.0f + 1e-6f; });
     });
   };
-  const bool actions_in_range = in_range(msg.actions) && in_range(msg.expert_actions);
-  if (!finite || !actions_in_range) {
+  if (!finite || !in_range(msg.actions) || !in_range(msg.expert_actions)) {
     ++counters_.dropped_non_finite;
-    return;
+    return false;
   }
-  std::int64_t& last = last_batch_seq_[static_cast<std::size_t>(msg.actor_id)];
-  if (last >= 0 && msg.batch_seq > last + 1) counters_.batches_lost += msg.batch_seq - last - 1;
-  last = msg.batch_seq;  // a lower number means the actor restarted: follow it
+  return true;
+}
 
+double LearnerNode::add_transitions(const auvrl_lcm::experience_batch_t& msg) {
   // Algorithm 1, line 11: a step trains only once |R| > m, so only transitions stored beyond
   // that threshold earn updates.
   const auto threshold = static_cast<std::size_t>(
       std::max<std::int64_t>(config_.ddpg.batch_size, config_.warmup_transitions));
   double credit = 0.0;
   using Vec = Eigen::Map<const nn::Vector>;
-  for (int i = 0; i < n; ++i) {
-    const auto& pos = msg.achieved_position_ned_m[static_cast<std::size_t>(i)];
-    const auto& goal = msg.goal_ned_m[static_cast<std::size_t>(i)];
+  for (int i = 0; i < msg.num_transitions; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const auto& pos = msg.achieved_position_ned_m[k];
+    const auto& goal = msg.goal_ned_m[k];
     const TransitionView t{
-        Vec(msg.states[i].data(), msg.state_dim), Vec(msg.actions[i].data(), msg.action_dim),
-        msg.rewards[static_cast<std::size_t>(i)], Vec(msg.next_states[i].data(), msg.state_dim),
-        msg.terminal[static_cast<std::size_t>(i)] != 0, Eigen::Vector3f(pos[0], pos[1], pos[2]),
-        Eigen::Vector3f(goal[0], goal[1], goal[2]),
+        Vec(msg.states[k].data(), msg.state_dim), Vec(msg.actions[k].data(), msg.action_dim),
+        msg.rewards[k], Vec(msg.next_states[k].data(), msg.state_dim), msg.terminal[k] != 0,
+        Eigen::Vector3f(pos[0], pos[1], pos[2]), Eigen::Vector3f(goal[0], goal[1], goal[2]),
         // Episode ids are per actor: the actor id in the top bits makes them global.
         (static_cast<std::uint64_t>(msg.actor_id) << 40) |
-            (static_cast<std::uint64_t>(msg.episode_id[static_cast<std::size_t>(i)]) &
-             ((std::uint64_t{1} << 40) - 1)),
-        static_cast<std::uint32_t>(msg.step_index[static_cast<std::size_t>(i)]),
-        msg.expert_rows != 0 ? msg.expert_actions[static_cast<std::size_t>(i)].data() : nullptr};
+            (static_cast<std::uint64_t>(msg.episode_id[k]) & ((std::uint64_t{1} << 40) - 1)),
+        static_cast<std::uint32_t>(msg.step_index[k]),
+        msg.expert_rows != 0 ? msg.expert_actions[k].data() : nullptr};
     const std::size_t slot = replay_->next_slot();
     const bool overwrote = replay_->size() == replay_->capacity();
     const std::uint64_t overwritten_episode = overwrote ? replay_->episode_id(slot) : 0;
@@ -185,16 +199,57 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
     if (her_) her_->on_add(*replay_, slot, overwrote, overwritten_episode);
     if (replay_->size() > threshold) credit += config_.updates_per_transition;
   }
-  counters_.transitions_received += n;
-  interval_transitions_ += n;
-  const double owed = update_credit_ + credit;
+  counters_.transitions_received += msg.num_transitions;
+  interval_transitions_ += msg.num_transitions;
+  return credit;
+}
+
+void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
+  ++counters_.batches_received;
+  if (msg.actor_id < 0 || msg.actor_id >= config_.max_actors) {
+    ++counters_.dropped_unknown_actor;
+    return;
+  }
+  if ((msg.round >= 0) != config_.reproducible && unrecoverable_.empty()) {
+    // No restart mends a mix of modes: the launcher starts every process in the same one.
+    unrecoverable_ = fmt::format(
+        "actor {} sends {} experience but this learner runs in the {} mode", msg.actor_id,
+        msg.round >= 0 ? "reproducible (rounds of)" : "asynchronous",
+        config_.reproducible ? "reproducible" : "asynchronous");
+    return;
+  }
+  if (!sound_batch(msg)) return;
+  if (config_.reproducible) {
+    switch (collector_->offer(msg, round_weights_.round() + 1)) {
+      case RoundCollector::Offer::kStored:
+        break;
+      case RoundCollector::Offer::kDuplicate:
+        ++counters_.round_duplicates;
+        break;
+      case RoundCollector::Offer::kOtherRound:
+        ++counters_.round_out_of_turn;
+        break;
+      case RoundCollector::Offer::kMalformed:
+        ++counters_.dropped_dims;
+        break;
+    }
+    return;
+  }
+  std::int64_t& last = last_batch_seq_[static_cast<std::size_t>(msg.actor_id)];
+  if (last >= 0 && msg.batch_seq > last + 1) counters_.batches_lost += msg.batch_seq - last - 1;
+  last = msg.batch_seq;  // a lower number means the actor restarted: follow it
+  const double owed = update_credit_ + add_transitions(msg);
   update_credit_ = std::min(owed, config_.max_update_backlog);
   counters_.updates_skipped += static_cast<std::int64_t>(owed - update_credit_);
 }
 
-void LearnerNode::on_weights_request(const auvrl_lcm::weights_request_t&) {
+void LearnerNode::on_weights_request(const auvrl_lcm::weights_request_t& msg) {
   ++counters_.weights_requests;
-  broadcast_requested_ = true;
+  if (config_.reproducible) {
+    answer_round_request(msg);
+  } else {
+    broadcast_requested_ = true;
+  }
 }
 
 void LearnerNode::on_episode(const auvrl_lcm::episode_report_t& msg) {
@@ -202,40 +257,151 @@ void LearnerNode::on_episode(const auvrl_lcm::episode_report_t& msg) {
     ++counters_.dropped_unknown_actor;
     return;
   }
-  ++counters_.episodes;
+  // The reproducible mode counts a round's episodes when it takes the round.
+  if (!config_.reproducible) ++counters_.episodes;
+}
+
+void LearnerNode::update_once() {
+  UpdateStats stats;
+  if (her_) {
+    replay_->sample(sample_rng_, config_.ddpg.batch_size, batch_);
+    her_->relabel(*replay_, beta_m(), sample_rng_, batch_);
+    stats = ddpg_->update(batch_);
+  } else {
+    stats = ddpg_->update(*replay_);
+  }
+  ++interval_updates_;
+  interval_critic_loss_ += stats.critic_loss;
+  interval_actor_loss_ += stats.actor_loss;
+  interval_mean_q_ += stats.mean_q;
+  if (stats.actor_updated) {
+    interval_expert_share_ += stats.expert_share;
+    interval_smooth_temporal_ += stats.smooth_temporal;
+    interval_smooth_spatial_ += stats.smooth_spatial;
+    ++interval_actor_updates_;
+  }
 }
 
 void LearnerNode::run_updates() {
+  if (config_.reproducible) {
+    run_round_updates();
+    return;
+  }
   const auto threshold = static_cast<std::size_t>(
       std::max<std::int64_t>(config_.ddpg.batch_size, config_.warmup_transitions));
   int done = 0;
   while (update_credit_ >= 1.0 && replay_->size() > threshold &&
          done < config_.max_updates_per_poll && !training_done()) {
-    UpdateStats stats;
-    if (her_) {
-      replay_->sample(sample_rng_, config_.ddpg.batch_size, batch_);
-      her_->relabel(*replay_, beta_m(), sample_rng_, batch_);
-      stats = ddpg_->update(batch_);
-    } else {
-      stats = ddpg_->update(*replay_);
-    }
+    update_once();
     update_credit_ -= 1.0;
     ++done;
-    ++interval_updates_;
-    interval_critic_loss_ += stats.critic_loss;
-    interval_actor_loss_ += stats.actor_loss;
-    interval_mean_q_ += stats.mean_q;
-    if (stats.actor_updated) {
-      interval_expert_share_ += stats.expert_share;
-      interval_smooth_temporal_ += stats.smooth_temporal;
-      interval_smooth_spatial_ += stats.smooth_spatial;
-      ++interval_actor_updates_;
-    }
     maybe_publish_weights();
   }
 }
 
+void LearnerNode::after_update() {
+  const std::int64_t updates = ddpg_->updates();
+  if (config_.checkpoint_every_updates > 0 && updates % config_.checkpoint_every_updates == 0) {
+    checkpoint();
+  }
+  if (config_.snapshot_every_updates > 0 && !config_.snapshot_dir.empty() &&
+      updates % config_.snapshot_every_updates == 0) {
+    write_snapshot();
+  }
+}
+
+void LearnerNode::write_snapshot() {
+  const std::string path =
+      fmt::format("{}/policy-{:012d}.nn", config_.snapshot_dir, ddpg_->updates());
+  try {
+    std::filesystem::create_directories(config_.snapshot_dir);
+    nn::save_network_file(path, ddpg_->actor());
+  } catch (const std::exception& e) {
+    // Training goes on; the launcher's choice of the best policy misses this one.
+    log_ << "auv_learner: SNAPSHOT FAILED: " << e.what() << "\n";
+  }
+}
+
+void LearnerNode::take_round_if_complete() {
+  if (round_updates_done_ < round_updates_owed_ || !collector_->complete()) return;
+  const std::int64_t round = round_weights_.round() + 1;
+  double credit = 0.0;
+  for (const auvrl_lcm::experience_batch_t& batch : collector_->take()) {
+    if (batch.round_batch == 0) counters_.episodes += batch.round_episodes;
+    credit += add_transitions(batch);
+  }
+  update_credit_ += credit;
+  round_updates_owed_ = static_cast<std::int64_t>(std::floor(update_credit_));
+  update_credit_ -= static_cast<double>(round_updates_owed_);
+  round_updates_done_ = 0;
+  round_weights_.begin(round);
+  round_next_index_ = 0;
+  ++counters_.rounds;
+  publish_round_weights(round_updates_owed_ == 0);
+}
+
+void LearnerNode::run_round_updates() {
+  int done = 0;
+  while (round_updates_done_ < round_updates_owed_ && done < config_.max_updates_per_poll &&
+         !training_done()) {
+    update_once();
+    ++round_updates_done_;
+    ++done;
+    if (round_updates_done_ == round_updates_owed_) {
+      publish_round_weights(true);
+    } else {
+      while (round_schedule_.updates_for_index(round_next_index_) <= round_updates_done_) {
+        publish_round_weights(false);
+      }
+    }
+    after_update();
+  }
+}
+
+const RoundWeights& LearnerNode::record_round_weights(bool final) {
+  RoundWeights w;
+  w.index = round_next_index_++;
+  w.final = final;
+  w.version = ddpg_->updates();
+  w.beta_m = beta_m();
+  w.episodes = counters_.episodes;
+  w.network = nn::network_to_bytes(ddpg_->actor());
+  round_weights_.add(std::move(w));
+  return *round_weights_.newest();
+}
+
+void LearnerNode::publish_round_weights(bool final) {
+  publish_weights_message(
+      round_weights_message(record_round_weights(final), round_weights_.round(), training_done()));
+}
+
+void LearnerNode::answer_round_request(const auvrl_lcm::weights_request_t& msg) {
+  const RoundWeights* newest = round_weights_.newest();
+  const RoundWeights* answer = nullptr;
+  if (msg.want_round < round_weights_.round()) {
+    answer = newest;  // -1 (the newest), or a round already passed: the actor moves on
+  } else if (msg.want_round == round_weights_.round()) {
+    answer = round_weights_.find(msg.want_index);
+    if (!answer && newest && newest->final && newest->index < msg.want_index) answer = newest;
+  }
+  // Otherwise not yet published: it goes out when due.
+  if (answer) {
+    publish_weights_message(round_weights_message(*answer, round_weights_.round(),
+                                                  training_done()));
+  }
+}
+
 void LearnerNode::maybe_publish_weights() {
+  if (config_.reproducible) {
+    // At the start and after a resume: every weights of the round, for actors that went back.
+    if (broadcast_requested_) {
+      for (const RoundWeights& w : round_weights_.all()) {
+        publish_weights_message(round_weights_message(w, round_weights_.round(), training_done()));
+      }
+      broadcast_requested_ = false;
+    }
+    return;
+  }
   const std::int64_t updates = ddpg_->updates();
   const bool due_by_count = updates - last_broadcast_updates_ >= config_.broadcast_every_updates;
   const bool rate_ok = Clock::now() - last_broadcast_ >= seconds(config_.broadcast_min_interval_s);
@@ -250,6 +416,9 @@ auvrl_lcm::policy_weights_t LearnerNode::weights_message() const {
   msg.episodes = counters_.episodes;
   msg.training_done = training_done();
   msg.updates_owed = update_credit_;
+  msg.round = -1;
+  msg.round_index = 0;
+  msg.round_final = false;
   const std::vector<std::uint8_t> bytes = nn::network_to_bytes(ddpg_->actor());
   msg.num_bytes = static_cast<std::int32_t>(bytes.size());
   msg.network.assign(bytes.begin(), bytes.end());
@@ -257,7 +426,17 @@ auvrl_lcm::policy_weights_t LearnerNode::weights_message() const {
 }
 
 void LearnerNode::publish_weights() {
-  const auvrl_lcm::policy_weights_t weights = weights_message();
+  if (config_.reproducible) {
+    // The newest of the round, with the schedule's end if it has come.
+    if (const RoundWeights* w = round_weights_.newest()) {
+      publish_weights_message(round_weights_message(*w, round_weights_.round(), training_done()));
+    }
+    return;
+  }
+  publish_weights_message(weights_message());
+}
+
+void LearnerNode::publish_weights_message(const auvrl_lcm::policy_weights_t& weights) {
   transport::publish(transport_, channels::kPolicyWeights, weights);
   auvrl_lcm::policy_summary_t summary;
   summary.utime = weights.utime;
@@ -275,7 +454,7 @@ void LearnerNode::publish_weights() {
   summary.architecture = ddpg_->actor().spec().describe();
   transport::publish(transport_, channels::kPolicySummary, summary);
   ++counters_.weights_published;
-  last_broadcast_updates_ = ddpg_->updates();
+  last_broadcast_updates_ = weights.version;
   last_broadcast_ = Clock::now();
   broadcast_requested_ = false;
 }
@@ -322,14 +501,20 @@ void LearnerNode::publish_stats() {
 }
 
 void LearnerNode::poll(int timeout_ms) {
-  const bool can_update = update_credit_ >= 1.0 && !training_done();
+  const bool owed = config_.reproducible ? round_updates_done_ < round_updates_owed_
+                                         : update_credit_ >= 1.0;
+  const bool can_update = owed && !training_done();
   transport_.handle(can_update || broadcast_requested_ ? 0 : timeout_ms);
   if (!unrecoverable_.empty()) throw UnrecoverableFault(unrecoverable_);
+  if (config_.reproducible && !training_done()) take_round_if_complete();
   run_updates();
   maybe_publish_weights();  // requests, and weights held back by the rate limit
   const auto now = Clock::now();
   if (now >= next_stats_) publish_stats();
-  if (!config_.checkpoint_dir.empty() && now >= next_checkpoint_) checkpoint();
+  // The reproducible mode checkpoints by update count (after_update).
+  if (!config_.reproducible && !config_.checkpoint_dir.empty() && now >= next_checkpoint_) {
+    checkpoint();
+  }
 }
 
 void LearnerNode::save(nn::Writer& w) const {
@@ -343,6 +528,16 @@ void LearnerNode::save(nn::Writer& w) const {
   nn::write_rng(w, sample_rng_);
   ddpg_->save(w);
   replay_->save(w);
+  // Version 2: the reproducible mode's round (its experience is taken; its updates are done
+  // up to round_updates_done_; the weights published for it so far).
+  w.u8(config_.reproducible ? 1 : 0);
+  if (config_.reproducible) {
+    w.u64(static_cast<std::uint64_t>(round_updates_owed_));
+    w.u64(static_cast<std::uint64_t>(round_updates_done_));
+    w.u32(static_cast<std::uint32_t>(round_next_index_));
+    w.u64(static_cast<std::uint64_t>(counters_.rounds));
+    round_weights_.save(w);
+  }
 }
 
 std::string LearnerNode::checkpoint() {
@@ -370,8 +565,8 @@ void LearnerNode::resume() {
         // Everything is read into new objects first: a damaged file changes nothing.
         r.expect_magic(kCheckpointMagic);
         const std::uint32_t version = r.u32();
-        if (version != kCheckpointVersion) {
-          r.fail("format version " + std::to_string(version) + ", expected " +
+        if (version != kCheckpointVersion && version != 1) {
+          r.fail("format version " + std::to_string(version) + ", expected 1 or " +
                  std::to_string(kCheckpointVersion));
         }
         const auto episodes = static_cast<std::int64_t>(r.u64());
@@ -388,12 +583,20 @@ void LearnerNode::resume() {
         auto replay = std::make_unique<ReplayBuffer>(
             config_.ddpg.state_dim, config_.ddpg.action_dim, config_.ddpg.replay_capacity);
         replay->restore(r);
+        const bool reproducible = version >= 2 && r.u8() != 0;
+        if (reproducible != config_.reproducible) {
+          r.fail(reproducible ? "a checkpoint of the reproducible mode; this learner is asynchronous"
+                              : "a checkpoint of the asynchronous mode; this learner is reproducible");
+        }
+        RoundState round;
+        if (reproducible) round = read_round_state(r);
         r.verify_checksum();
         ddpg_ = std::move(ddpg);
         replay_ = std::move(replay);
         counters_.episodes = episodes;
         counters_.transitions_received = transitions;
-        update_credit_ = std::clamp(credit, 0.0, config_.max_update_backlog);
+        update_credit_ = reproducible ? credit : std::clamp(credit, 0.0, config_.max_update_backlog);
+        if (reproducible) restore_round_state(std::move(round));
         seqs.resize(static_cast<std::size_t>(config_.max_actors), -1);
         last_batch_seq_ = std::move(seqs);
         sample_rng_ = sample_rng;
@@ -403,6 +606,31 @@ void LearnerNode::resume() {
   broadcast_requested_ = true;
   log_ << "auv_learner: resumed from " << file.path << " (" << ddpg_->updates() << " updates, "
        << replay_->size() << " transitions, " << counters_.episodes << " episodes)\n";
+}
+
+LearnerNode::RoundState LearnerNode::read_round_state(nn::Reader& r) {
+  RoundState state;
+  state.owed = static_cast<std::int64_t>(r.u64());
+  state.done = static_cast<std::int64_t>(r.u64());
+  state.next_index = static_cast<std::int32_t>(r.u32());
+  state.rounds = static_cast<std::int64_t>(r.u64());
+  state.weights.restore(r);
+  if (state.owed < 0 || state.done < 0 || state.done > state.owed || state.next_index < 0 ||
+      !state.weights.newest()) {
+    r.fail("inconsistent round state (updates owed " + std::to_string(state.owed) + ", done " +
+           std::to_string(state.done) + ")");
+  }
+  return state;
+}
+
+void LearnerNode::restore_round_state(RoundState state) {
+  round_updates_owed_ = state.owed;
+  round_updates_done_ = state.done;
+  round_next_index_ = state.next_index;
+  counters_.rounds = state.rounds;
+  round_weights_ = std::move(state.weights);
+  // Whatever was collected of the next round came before the restart: the actors send it again.
+  collector_->clear();
 }
 
 void LearnerNode::finish() {

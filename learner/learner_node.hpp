@@ -21,6 +21,8 @@
 #include "learner/ddpg.hpp"
 #include "learner/hindsight.hpp"
 #include "learner/replay_buffer.hpp"
+#include "learner/rounds.hpp"
+#include "common/round_schedule.hpp"
 
 namespace auvrl::learner {
 
@@ -61,9 +63,21 @@ struct LearnerNodeConfig {
   std::int64_t max_updates = 0;   ///< or after this many updates (0: never)
 
   std::string checkpoint_dir;  ///< empty: no checkpoints
-  double checkpoint_period_s = 300.0;
+  double checkpoint_period_s = 300.0;  ///< asynchronous mode
+  /// Reproducible mode: a checkpoint after every this many updates (0: none but the last).
+  std::int64_t checkpoint_every_updates = 100000;
   int keep_checkpoints = 2;
   std::string policy_path;  ///< where finish() writes the actor network (optional)
+
+  /// Reproducible mode (common/round_schedule.hpp): experience in rounds from exactly
+  /// max_actors actors, taken in actor order; weights published by round and index; every
+  /// period counted in updates. The same seed then gives the same bytes.
+  bool reproducible = false;
+  int round_weights_every_steps = 100;  ///< RoundSchedule::weights_every_steps
+  /// Reproducible mode: the actor network is written to snapshot_dir/policy-<updates>.nn
+  /// every snapshot_every_updates updates (the launcher's choice of the best policy).
+  std::string snapshot_dir;
+  std::int64_t snapshot_every_updates = 0;
 };
 
 /// The keys of a `learner:` section: ddpg_table() and the node's own (learner_config.cpp).
@@ -83,6 +97,9 @@ struct LearnerCounters {
   std::int64_t checkpoints_written = 0;
   std::int64_t updates_skipped = 0;
   std::int64_t dropped_decode = 0;
+  std::int64_t rounds = 0;             ///< reproducible mode: rounds taken
+  std::int64_t round_duplicates = 0;   ///< reproducible mode: resent batches already held
+  std::int64_t round_out_of_turn = 0;  ///< reproducible mode: batches of another round
 };
 
 /// The learner as a transport participant. Single-threaded: call poll() in a loop.
@@ -121,10 +138,41 @@ class LearnerNode {
  private:
   /// Sets unrecoverable_ when a sound batch has other sizes than the networks.
   void note_other_sizes(const auvrl_lcm::experience_batch_t& msg);
+  /// Checks a batch's sizes and values (counting what it drops); true when it may be used.
+  bool sound_batch(const auvrl_lcm::experience_batch_t& msg);
+  /// Stores the batch's transitions; returns the updates they earn.
+  double add_transitions(const auvrl_lcm::experience_batch_t& msg);
   void on_experience(const auvrl_lcm::experience_batch_t& msg);
   void on_weights_request(const auvrl_lcm::weights_request_t& msg);
   void on_episode(const auvrl_lcm::episode_report_t& msg);
   void run_updates();
+  /// After each update: checkpoints and snapshots due by update count.
+  void after_update();
+
+  // Reproducible mode (learner/rounds.hpp).
+  /// Takes the awaited round once complete: its transitions in actor order, the updates owed.
+  void take_round_if_complete();
+  /// Runs the current round's updates, publishing each index as it falls due.
+  void run_round_updates();
+  /// Publishes index `index` of the current round (final when the round's updates are done).
+  void publish_round_weights(bool final);
+  void answer_round_request(const auvrl_lcm::weights_request_t& msg);
+  /// Adds the next index of the current round's weights to the history and returns it.
+  const RoundWeights& record_round_weights(bool final);
+  /// Publishes weights (and their summary) and counts them.
+  void publish_weights_message(const auvrl_lcm::policy_weights_t& weights);
+  void write_snapshot();
+  void update_once();
+  /// The reproducible mode's round as a checkpoint holds it.
+  struct RoundState {
+    std::int64_t owed = 0;
+    std::int64_t done = 0;
+    std::int32_t next_index = 0;
+    std::int64_t rounds = 0;
+    RoundWeightsHistory weights;
+  };
+  static RoundState read_round_state(nn::Reader& r);
+  void restore_round_state(RoundState state);
   /// Publishes the weights if requested, or if due by update count and allowed by the rate.
   void maybe_publish_weights();
   void publish_weights();
@@ -147,6 +195,14 @@ class LearnerNode {
   std::vector<std::int64_t> last_batch_seq_;  ///< per actor, -1: none yet
 
   double update_credit_ = 0.0;
+
+  // Reproducible mode.
+  RoundSchedule round_schedule_;
+  std::unique_ptr<RoundCollector> collector_;
+  RoundWeightsHistory round_weights_;  ///< round_weights_.round(): the last round taken
+  std::int64_t round_updates_owed_ = 0;
+  std::int64_t round_updates_done_ = 0;
+  std::int32_t round_next_index_ = 0;
   std::int64_t last_broadcast_updates_ = -1;
   bool broadcast_requested_ = true;  ///< answer a request (or announce a start) at once
   std::chrono::steady_clock::time_point last_broadcast_;
