@@ -200,6 +200,14 @@ int run_train(int argc, const char* const* argv) {
              "exploration actors (default: run.actors, 0 = one per CPU)");
   cli.option("max-seconds", &options.max_train_s, "training budget, s (default: run.max_train_s)");
   cli.option("seed", &options.seed, "seed of the run (default: run.seed)");
+  cli.flag("reproducible", &options.reproducible,
+           "reproducible mode (run.reproducible): the same seed, configuration and build give "
+           "byte-identical checkpoints, policies and evaluation; the budget counts updates "
+           "(learner.max_updates or --max-updates), --max-seconds is not used");
+  cli.option("max-updates", &options.max_updates,
+             "end of training after this many updates (default: learner.max_updates, 0 = "
+             "never)");
+  cli.check("max-updates", auvrl::cli::at_least(0));
   cli.option("finetune-iterations", &options.finetune_iterations,
              "fine-tuning iterations after training (default: finetune.iterations, 0 = none)");
   cli.flag("no-eval", &no_eval, "skip evaluation, plots and report");

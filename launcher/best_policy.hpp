@@ -1,11 +1,15 @@
 // The best policy of a training run: the newest weights are scored now and then by a quick
 // evaluation (eval::QuickEvaluator) and the best by eval::ranks_above is kept in
-// policy_best.nn.
+// policy_best.nn. In reproducible mode the weights scored are the learner's snapshots
+// (<run>/snapshots/policy-<updates>.nn), each of them, in update order.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/nn/mlp.hpp"
 #include "eval/evaluation.hpp"
@@ -48,6 +52,43 @@ class BestPolicyKeeper {
   std::string run_dir_;
   eval::ValidationScore best_;
   std::int64_t best_version_ = -1;
+};
+
+/// One actor network the learner wrote in reproducible mode (auv_learner --snapshot-dir).
+struct PolicySnapshot {
+  std::int64_t updates = 0;  ///< the learner's update count when it wrote it
+  std::string path;          ///< <dir>/policy-<updates, 12 digits>.nn
+};
+
+/// The snapshots in dir in increasing update order: the files named policy-<digits>.nn. The
+/// learner's temporary files and anything else are left out; a missing dir holds none.
+std::vector<PolicySnapshot> list_snapshots(const std::string& dir);
+
+/// Hands the learner's snapshots in dir to a BestPolicyKeeper, each once and in update order,
+/// and deletes each file once considered, so that the best policy of a reproducible run does
+/// not depend on the machine's speed.
+class SnapshotReviewer {
+ public:
+  /// dir: where the learner writes its snapshots (<run>/snapshots).
+  explicit SnapshotReviewer(std::string dir) : dir_(std::move(dir)) {}
+
+  /// Considers the oldest max_count snapshots in dir (version = their updates, at wall_s) and
+  /// deletes them. A snapshot at or below the updates of one considered before is deleted
+  /// unread (a learner restarted from an older checkpoint writes it again). One that cannot be
+  /// read, or whose evaluation fails, is reported on out and deleted: the learner writes
+  /// atomically, so an unreadable one is damage. Returns how many files were taken.
+  std::size_t review(BestPolicyKeeper& keeper, double wall_s, QuickEvalSink& quick_eval,
+                     std::ostream& out, std::size_t max_count);
+
+  /// The updates of the last snapshot considered (-1: none yet).
+  std::int64_t last_updates() const { return last_updates_; }
+
+ private:
+  /// Deletes a snapshot's file; a failure is reported on out.
+  static void remove(const PolicySnapshot& snapshot, std::ostream& out);
+
+  std::string dir_;
+  std::int64_t last_updates_ = -1;
 };
 
 }  // namespace auvrl::launcher

@@ -29,15 +29,29 @@ constexpr const char* kPreamble =
     "(config/vehicles/X.pid.yaml, written by `auvrl tune-pid`) and a mission file\n"
     "(config/missions/X.yaml, docs/missions.md).\n";
 
+/// Under the `run` section's heading: what reproducible mode changes.
+constexpr const char* kReproducibleNote =
+    "Reproducible mode (`reproducible: true`, or `auvrl train --reproducible`): the same seed,\n"
+    "configuration and build give byte-identical checkpoints, policies and evaluation, whatever\n"
+    "the machine's speed. The learner and the actors run deterministically (each takes\n"
+    "`--reproducible`; an actor switches to the learner's next weights every\n"
+    "`round_weights_every_steps` of its steps, and a restarted actor keeps its seed). The budget\n"
+    "counts updates: `learner.max_updates` (or `--max-updates N`) or `learner.max_episodes`\n"
+    "must be set, and `max_train_s` is not used. The best policy is chosen from the learner's\n"
+    "snapshots (`RUN/snapshots/`), one every `best_eval_every_updates` updates, each evaluated\n"
+    "in update order, instead of from the newest weights every `best_eval_period_s`.";
+
 }  // namespace
 
 std::string configuration_reference() {
+  config::SectionDoc run = config::section_doc(run_table());
+  run.doc += std::string("\n\n") + kReproducibleNote;
   const std::vector<config::SectionDoc> sections = {
       config::section_doc(task::task_table()),
       config::section_doc(task::goal_schedule_table()),
       config::section_doc(learner::learner_table()),
       config::section_doc(agent::actor_table()),
-      config::section_doc(run_table()),
+      run,
       config::section_doc(finetune_table()),
       config::section_doc(transport::transport_table()),
       sim::vehicle_file_doc(),

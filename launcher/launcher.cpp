@@ -32,6 +32,8 @@ std::vector<std::string> namespace_command(const TrainOptions& options) {
   if (options.actors >= 0) pass("--actors", std::to_string(options.actors));
   if (options.max_train_s >= 0) pass("--max-seconds", std::to_string(options.max_train_s));
   if (options.seed >= 0) pass("--seed", std::to_string(options.seed));
+  if (options.reproducible) args.push_back("--reproducible");
+  if (options.max_updates >= 0) pass("--max-updates", std::to_string(options.max_updates));
   if (options.finetune_iterations >= 0) {
     pass("--finetune-iterations", std::to_string(options.finetune_iterations));
   }

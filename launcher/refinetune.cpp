@@ -40,7 +40,7 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   train.run_dir = o.run_dir;
   train.source_dir = o.source_dir;
   train.seed = o.seed;
-  RunContext ctx = load_run_context(train);
+  RunContext ctx = load_run_context(train, ContextUse::kAfterTraining);
   if (!o.config_path.empty()) ctx.rc.finetune = read_run_config(o.config_path).finetune;
   if (o.iterations >= 0) ctx.rc.finetune.iterations = o.iterations;
   ctx.run_dir = o.out_dir;

@@ -15,11 +15,21 @@ config::Table<RunSettings> make_run_table() {
   using C = RunSettings;
   config::Table<C> t("run", "the launcher (auvrl train): processes, budget, supervision");
   t.field("actors", &C::actors, "0: one per CPU", "exploration actors").range(0);
-  t.field("seed", &C::seed, "", "actor i uses seed * 1000 + i (+ a restart offset)");
+  t.field("seed", &C::seed, "",
+          "actor i uses seed * 1000 + i (+ a restart offset, none when reproducible)");
   t.field("max_train_s", &C::max_train_s, "s, 0: until the learner ends",
-          "wall-clock training budget");
+          "wall-clock training budget (not used when reproducible)");
+  t.field("reproducible", &C::reproducible, "",
+          "the same seed, configuration and build give byte-identical checkpoints, policies "
+          "and evaluation; budgets count updates, not seconds");
+  t.field("round_weights_every_steps", &C::round_weights_every_steps, "actor steps",
+          "reproducible: an actor switches to the learner's next weights this often")
+      .range(1);
+  t.field("best_eval_every_updates", &C::best_eval_every_updates, "updates",
+          "reproducible: quick evaluation of the learner's weights this often")
+      .range(1);
   t.field("best_eval_period_s", &C::best_eval_period_s, "s",
-          "quick evaluation of the newest weights this often");
+          "quick evaluation of the newest weights this often (not reproducible)");
   t.field("best_eval_suite", &C::best_eval_suite, "way-points",
           "validation way-points in that quick evaluation");
   t.field("best_eval_max_hold_m", &C::best_eval_max_hold_m, "m, > 0",
@@ -95,6 +105,7 @@ RunConfig read_run_config(const std::string& path) {
   task::read_task_config(root.child("task"), c.task);
   config::Section learner = root.child("learner");
   learner.read("max_episodes", c.learner_max_episodes);
+  learner.read("max_updates", c.learner_max_updates);
   config::Section run = root.child("run");
   run_table().read_keys(run, c.run);
   if (!(c.run.best_eval_max_hold_m > 0.0)) {

@@ -1,5 +1,6 @@
 // The run configuration as the launcher reads it: the `run:` section (its own), and what it
-// needs of the others (vehicle, task, learner.max_episodes, transport, finetune).
+// needs of the others (vehicle, task, learner.max_episodes and max_updates, transport,
+// finetune).
 #pragma once
 
 #include <cstdint>
@@ -15,9 +16,20 @@ namespace auvrl::launcher {
 
 /// The `run:` section of a run configuration.
 struct RunSettings {
-  int actors = 0;                   ///< 0: one per CPU
-  std::uint64_t seed = 1;           ///< actor i uses seed * 1000 + i (+ a restart offset)
-  double max_train_s = 0.0;         ///< wall-clock training budget, s (0: until the learner ends)
+  int actors = 0;            ///< 0: one per CPU
+  std::uint64_t seed = 1;    ///< actor i uses seed * 1000 + i (+ a restart offset)
+  double max_train_s = 0.0;  ///< wall-clock training budget, s (0: until the learner ends)
+  /// The same seed, configuration and build give byte-identical checkpoints, policies and
+  /// evaluation: the learner and the actors run deterministically (a restarted actor keeps its
+  /// seed), budgets count updates (learner.max_updates or max_episodes), not seconds
+  /// (max_train_s is not used), and the best policy is chosen from the learner's snapshots.
+  bool reproducible = false;
+  /// In reproducible mode an actor switches to the learner's next weights every this many of
+  /// its steps.
+  int round_weights_every_steps = 100;
+  /// In reproducible mode the quick evaluation of the best policy looks at the learner's
+  /// weights every this many updates (the learner's snapshots).
+  std::int64_t best_eval_every_updates = 40000;
   double best_eval_period_s = 5.0;  ///< quick evaluation of the newest weights, s
   int best_eval_suite = 40;         ///< validation way-points in that quick evaluation
   /// The best policy holds within this on average on them, m (eval::ranks_above):
@@ -45,9 +57,10 @@ struct RunConfig {
   RunSettings run;
   task::TaskConfig task;
   std::string vehicle_path;
-  std::int64_t learner_max_episodes = 0;
-  transport::TransportConfig transport;  ///< the `transport:` section (LCM by default)
-  tuning::FinetuneConfig finetune;       ///< the `finetune:` section (off by default)
+  std::int64_t learner_max_episodes = 0;  ///< learner.max_episodes (0: never)
+  std::int64_t learner_max_updates = 0;   ///< learner.max_updates (0: never)
+  transport::TransportConfig transport;   ///< the `transport:` section (LCM by default)
+  tuning::FinetuneConfig finetune;        ///< the `finetune:` section (off by default)
 };
 
 /// Reads and checks a run configuration; throws config::ConfigError naming file, key and line.

@@ -9,6 +9,7 @@
 
 #include "launcher/launcher.hpp"
 #include "launcher/run_config.hpp"
+#include "launcher/training.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace auvrl::launcher {
@@ -73,6 +74,8 @@ void write_readme(const std::string& run_dir) {
            "                    time ratio to the PID's on the same way-points, kept)\n"
         << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"
         << "  processes/        each process's output\n"
+        << "  snapshots/        reproducible runs: the learner's networks awaiting the quick\n"
+           "                    evaluation (each is deleted once evaluated)\n"
         << "Watch the running system with lcm-spy: scripts/spy.sh " << run_dir << "\n";
 }
 
@@ -89,7 +92,11 @@ std::string prepare_run_directory(TrainOptions& o) {
   if (o.config_path.empty() || !fs::is_regular_file(o.config_path)) {
     throw std::runtime_error("configuration '" + o.config_path + "' not found");
   }
-  read_run_config(o.config_path);  // a broken configuration fails here, before anything starts
+  // A broken configuration, or a reproducible run without a budget in updates, fails here,
+  // before anything starts.
+  RunConfig parsed = read_run_config(o.config_path);
+  apply_train_options(o, parsed);
+  check_reproducible_budget(parsed);
   if (o.run_dir.empty()) {
     o.run_dir = (fs::path(o.source_dir) / "runs" /
                  (fs::path(o.config_path).stem().string() + "-" + run_timestamp()))

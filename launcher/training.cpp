@@ -12,8 +12,10 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
+#include <stdexcept>
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
@@ -29,15 +31,35 @@ namespace auvrl::launcher {
 
 namespace fs = std::filesystem;
 
-RunContext load_run_context(const TrainOptions& options) {
+std::string snapshot_dir(const std::string& run_dir) {
+  return (fs::path(run_dir) / "snapshots").string();
+}
+
+void apply_train_options(const TrainOptions& options, RunConfig& rc) {
+  if (options.actors >= 0) rc.run.actors = options.actors;
+  if (options.max_train_s >= 0) rc.run.max_train_s = options.max_train_s;
+  if (options.seed >= 0) rc.run.seed = static_cast<std::uint64_t>(options.seed);
+  if (options.reproducible) rc.run.reproducible = true;
+  if (options.max_updates >= 0) rc.learner_max_updates = options.max_updates;
+  if (options.finetune_iterations >= 0) rc.finetune.iterations = options.finetune_iterations;
+}
+
+void check_reproducible_budget(const RunConfig& rc) {
+  if (!rc.run.reproducible || rc.learner_max_updates > 0 || rc.learner_max_episodes > 0) return;
+  throw std::runtime_error(
+      "--reproducible (run.reproducible) counts the training budget in updates, not seconds "
+      "(run.max_train_s is not used): set learner.max_updates in the run file or give "
+      "--max-updates N (the fast preset reaches about 600000 updates in its 85 s on 2 cores), "
+      "or set learner.max_episodes");
+}
+
+RunContext load_run_context(const TrainOptions& options, ContextUse use) {
   RunContext ctx{
       options, options.run_dir, (fs::path(options.run_dir) / "config.yaml").string(), {}, {}, 1, 1};
   RunConfig& rc = ctx.rc;
   rc = read_run_config(ctx.config_path);
-  if (options.actors >= 0) rc.run.actors = options.actors;
-  if (options.max_train_s >= 0) rc.run.max_train_s = options.max_train_s;
-  if (options.seed >= 0) rc.run.seed = static_cast<std::uint64_t>(options.seed);
-  if (options.finetune_iterations >= 0) rc.finetune.iterations = options.finetune_iterations;
+  apply_train_options(options, rc);
+  if (use == ContextUse::kTraining) check_reproducible_budget(rc);
   ctx.cpus = std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   ctx.actors = rc.run.actors > 0 ? rc.run.actors : ctx.cpus;
   ctx.model = sim::load_vehicle_file(rc.vehicle_path);
@@ -78,6 +100,29 @@ std::vector<std::string> lockstep_args(const RunContext& ctx, int i) {
           fmt::format("udpm://239.255.76.67:{}?ttl=0&recv_buf_size=1048576", 7668 + i)};
 }
 
+/// The flags of reproducible mode that the learner and the actors share (none otherwise).
+std::vector<std::string> reproducible_args(const RunContext& ctx) {
+  if (!ctx.rc.run.reproducible) return {};
+  return {"--reproducible", "--round-weights-every-steps",
+          std::to_string(ctx.rc.run.round_weights_every_steps)};
+}
+
+/// The learner's flags that the launcher's settings add to its configuration: a --max-updates
+/// override (the learner reads learner.max_updates from config.yaml itself) and, in
+/// reproducible mode, the snapshots the best policy is chosen from.
+std::vector<std::string> learner_schedule_args(const RunContext& ctx) {
+  std::vector<std::string> args = reproducible_args(ctx);
+  if (ctx.rc.run.reproducible) {
+    args.insert(args.end(),
+                {"--snapshot-dir", snapshot_dir(ctx.run_dir), "--snapshot-every-updates",
+                 std::to_string(ctx.rc.run.best_eval_every_updates)});
+  }
+  if (ctx.options.max_updates >= 0) {
+    args.insert(args.end(), {"--max-updates", std::to_string(ctx.options.max_updates)});
+  }
+  return args;
+}
+
 /// The learner's command line (pinned to run.learner_cpu when set).
 std::vector<std::string> learner_argv(const RunContext& ctx, const std::string& bin) {
   std::vector<std::string> argv = {bin + "auv_learner", "--config", ctx.config_path,
@@ -88,6 +133,7 @@ std::vector<std::string> learner_argv(const RunContext& ctx, const std::string& 
                                    // The run's seed also seeds the networks, the minibatches
                                    // and TD3's noise.
                                    "--seed", std::to_string(ctx.rc.run.seed)};
+  argv = concat(argv, learner_schedule_args(ctx));
   if (ctx.rc.run.learner_cpu >= 0 && ctx.rc.run.learner_cpu < ctx.cpus) {
     argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(ctx.rc.run.learner_cpu)});
   }
@@ -95,20 +141,23 @@ std::vector<std::string> learner_argv(const RunContext& ctx, const std::string& 
 }
 
 /// Actor i's role: a restarted actor explores anew (another seed) rather than repeating its
-/// first life.
+/// first life; in reproducible mode it is the same actor (the same seed), and the learner tells
+/// it where to resume.
 RoleSpec actor_role(const RunContext& ctx, int i, int cpu, const std::string& bin,
                     const std::vector<std::string>& transport_args) {
   const std::uint64_t seed = ctx.rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
-  const std::vector<std::string> bus = concat(lockstep_args(ctx, i), transport_args);
+  const std::uint64_t restart_seed_step = ctx.rc.run.reproducible ? 0 : 7919;
+  const std::vector<std::string> rest =
+      concat(reproducible_args(ctx), concat(lockstep_args(ctx, i), transport_args));
   const std::string config_path = ctx.config_path;
   RoleSpec role = fixed_role(ctx, "actor" + std::to_string(i), RoleKind::kActor, {});
   role.actor_id = i;
   role.argv = [=](std::size_t restarts) {
-    return concat(
-        {bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
-         "--vehicle-id", std::to_string(i), "--seed", std::to_string(seed + 7919 * restarts),
-         "--pin-cpu", std::to_string(cpu), "--report-every", "100"},
-        bus);
+    return concat({bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
+                   "--vehicle-id", std::to_string(i), "--seed",
+                   std::to_string(seed + restart_seed_step * restarts), "--pin-cpu",
+                   std::to_string(cpu), "--report-every", "100"},
+                  rest);
   };
   return role;
 }
@@ -202,8 +251,14 @@ class TrainingSession {
   double wall_s() const { return trained_before_s_ + clock_.now_s() - start_s_; }
   void subscribe();
   void start_processes();
+  /// One line on the mode and the budget; in reproducible mode the snapshot folder.
+  void announce_mode();
   SupervisionOutcome supervise_pass();
   void evaluate_newest_weights();
+  /// Reproducible mode: the quick evaluation of up to max_count of the learner's snapshots.
+  void review_snapshots(std::size_t max_count);
+  /// Training time left by the budget, s (-1: unknown).
+  double left_s() const;
   std::optional<std::string> show_progress();
   std::string status_line(double eta_s) const;
   void stop_processes();
@@ -226,6 +281,7 @@ class TrainingSession {
   Supervisor supervisor_;
   TrainingFigures figures_;
   std::unique_ptr<BestPolicyKeeper> best_;
+  SnapshotReviewer snapshots_{snapshot_dir(ctx_.run_dir)};
   std::optional<std::string> vehicle_fault_;
   double start_s_ = clock_.now_s();
   double next_progress_s_ = 0;
@@ -270,6 +326,8 @@ void TrainingSession::subscribe() {
       [this](const std::string&, const auvrl_lcm::logger_heartbeat_t& h) {
         supervisor_.heard_from_pid(h.pid);
       });
+  // Reproducible mode evaluates the learner's snapshots instead of the broadcast weights.
+  if (ctx_.rc.run.reproducible) return;
   weights_ = std::make_unique<transport::Latest<auvrl_lcm::policy_weights_t>>(
       *transport_, channels::kPolicyWeights, 4);
 }
@@ -286,6 +344,28 @@ void TrainingSession::start_processes() {
   out_ << "auvrl train: " << ctx_.actors << " actors on " << ctx_.cpus << " CPUs, "
        << transport::describe(ctx_.rc.transport) << ", run " << ctx_.run_dir
        << "\n  watch it: scripts/spy.sh " << ctx_.run_dir << "\n";
+}
+
+void TrainingSession::announce_mode() {
+  const RunConfig& rc = ctx_.rc;
+  if (!rc.run.reproducible) {
+    if (ctx_.options.resume && fs::exists(snapshot_dir(ctx_.run_dir))) {
+      out_ << "auvrl train: note: " << ctx_.run_dir
+           << " was trained with --reproducible (it has snapshots/); without it this "
+              "invocation trains asynchronously (give --reproducible to continue reproducibly)\n";
+    }
+    return;
+  }
+  fs::create_directories(snapshot_dir(ctx_.run_dir));
+  std::string budget;
+  if (rc.learner_max_updates > 0) budget = fmt::format("{} updates", rc.learner_max_updates);
+  if (rc.learner_max_episodes > 0) {
+    budget += fmt::format("{}{} episodes", budget.empty() ? "" : " or ", rc.learner_max_episodes);
+  }
+  out_ << "auvrl train: reproducible mode: budget " << budget
+       << " (the learner's schedule; run.max_train_s is not used), weights rounded every "
+       << rc.run.round_weights_every_steps << " actor steps, best policy from snapshots every "
+       << rc.run.best_eval_every_updates << " updates\n";
 }
 
 void TrainingSession::evaluate_newest_weights() {
@@ -314,16 +394,34 @@ std::string TrainingSession::status_line(double eta_s) const {
       format_duration(eta_s));
 }
 
+void TrainingSession::review_snapshots(std::size_t max_count) {
+  snapshots_.review(*best_, wall_s(), telemetry_.quick_eval, out_, max_count);
+}
+
+double TrainingSession::left_s() const {
+  const RunConfig& rc = ctx_.rc;
+  if (!rc.run.reproducible && rc.run.max_train_s > 0) return rc.run.max_train_s - wall_s();
+  double left = -1;
+  if (rc.learner_max_episodes > 0 && figures_.learner_episodes > 0 && figures_.episodes_seen > 0) {
+    left = static_cast<double>(rc.learner_max_episodes - figures_.learner_episodes) *
+           ((clock_.now_s() - start_s_) / static_cast<double>(figures_.episodes_seen));
+  }
+  // Reproducible mode: the updates still to do at the learner's rate (the sooner end counts).
+  const double updates_per_s = figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0;
+  if (rc.run.reproducible && rc.learner_max_updates > 0 && updates_per_s > 0) {
+    const double by_updates =
+        std::max<double>(
+            0.0, static_cast<double>(rc.learner_max_updates - figures_.last_stats->updates)) /
+        updates_per_s;
+    left = left < 0 ? by_updates : std::min(left, by_updates);
+  }
+  return left;
+}
+
 std::optional<std::string> TrainingSession::show_progress() {
   if (clock_.now_s() < next_progress_s_) return std::nullopt;
   next_progress_s_ = clock_.now_s() + 1.0;
-  double eta_s = -1;
-  if (ctx_.rc.run.max_train_s > 0) {
-    eta_s = ctx_.rc.run.max_train_s - wall_s();
-  } else if (ctx_.rc.learner_max_episodes > 0 && figures_.learner_episodes > 0) {
-    eta_s = static_cast<double>(ctx_.rc.learner_max_episodes - figures_.learner_episodes) *
-            ((clock_.now_s() - start_s_) / static_cast<double>(figures_.episodes_seen));
-  }
+  const double eta_s = left_s();
   ProgressRow row{wall_s(),
                   figures_.learner_episodes,
                   figures_.success_rate(),
@@ -390,14 +488,21 @@ SupervisionOutcome TrainingSession::supervise_pass() {
   if (signals::stop_requested()) return {true, 130, "stopped by the user"};
   if (vehicle_fault_) return {true, 1, *vehicle_fault_, false};
   if (auto discarding = discarding_actor()) return {true, 1, *discarding};
-  if (ctx_.rc.run.max_train_s > 0 && wall_s() >= ctx_.rc.run.max_train_s) {
-    return {true, 0,
-            fmt::format("training budget of {} used", format_duration(ctx_.rc.run.max_train_s))};
+  // Reproducible mode ends with the learner's schedule: a wall-clock budget would make the
+  // result depend on the machine's speed.
+  const double max_train_s = ctx_.rc.run.reproducible ? 0.0 : ctx_.rc.run.max_train_s;
+  if (max_train_s > 0 && wall_s() >= max_train_s) {
+    return {true, 0, fmt::format("training budget of {} used", format_duration(max_train_s))};
   }
   SupervisionOutcome outcome = supervisor_.poll();
   if (outcome.stop) return outcome;
-  // Keep the best policy: evaluate the newest weights now and then.
-  evaluate_newest_weights();
+  // Keep the best policy: evaluate the newest weights now and then, or in reproducible mode
+  // the learner's next snapshot (one per pass, so that supervision goes on between them).
+  if (ctx_.rc.run.reproducible) {
+    review_snapshots(1);
+  } else {
+    evaluate_newest_weights();
+  }
   if (auto error = show_progress()) return {true, 1, *error};
   return {};
 }
@@ -434,6 +539,7 @@ void TrainingSession::print_summary(const SupervisionOutcome& outcome) {
 
 TrainingResult TrainingSession::run() {
   signals::install_stop_handlers();
+  announce_mode();
   subscribe();
   start_processes();
   // Supervise, show progress, keep the best policy.
@@ -447,6 +553,18 @@ TrainingResult TrainingSession::run() {
   if (tty_) out_ << "\n";
   out_ << "auvrl train: " << outcome.stop_reason << "; stopping\n";
   stop_processes();
+  if (ctx_.rc.run.reproducible) {
+    // Every snapshot is evaluated, however fast the machine. Stopped by the user, the rest
+    // wait in snapshots/ for a --resume.
+    if (outcome.exit_code != 130) {
+      review_snapshots(std::numeric_limits<std::size_t>::max());
+    } else if (const std::size_t left = list_snapshots(snapshot_dir(ctx_.run_dir)).size();
+               left > 0) {
+      out_ << "auvrl train: " << left
+           << " snapshots not evaluated yet; a --resume evaluates them\n";
+    }
+    telemetry_.flush();
+  }
   print_summary(outcome);
   return {outcome.exit_code, std::move(best_)};
 }

@@ -30,12 +30,35 @@ struct RunContext {
   int actors = 1;  ///< actor (and simulator) processes
 };
 
-/// Reads the run's configuration and vehicle and applies the command line's overrides.
-RunContext load_run_context(const TrainOptions& options);
+/// What a run's context is loaded for.
+enum class ContextUse {
+  kTraining,       ///< `auvrl train`: the training budget is checked
+  kAfterTraining,  ///< fine-tuning or evaluating a trained run (`auvrl finetune`)
+};
+
+/// Reads the run's configuration and vehicle and applies the command line's overrides. For
+/// training, a reproducible run without a budget in updates or episodes is refused
+/// (check_reproducible_budget).
+RunContext load_run_context(const TrainOptions& options, ContextUse use = ContextUse::kTraining);
+
+/// Applies the command line's overrides (--actors, --max-seconds, --seed, --reproducible,
+/// --max-updates, --finetune-iterations) to a run configuration.
+void apply_train_options(const TrainOptions& options, RunConfig& rc);
+
+/// A reproducible run counts its budget in updates (learner.max_updates) or episodes
+/// (learner.max_episodes), never in seconds: throws std::runtime_error naming what to set when
+/// it has neither. Nothing for an asynchronous run.
+void check_reproducible_budget(const RunConfig& rc);
+
+/// Where the learner writes its snapshots in reproducible mode: <run_dir>/snapshots.
+std::string snapshot_dir(const std::string& run_dir);
 
 /// The command lines of the roles, in start order: the logger, one simulator per actor, the
 /// learner (with --resume when a checkpoint exists at its start), the actors. transport_args
-/// are appended to each (before the learner's --resume).
+/// are appended to each (before the learner's --resume). A --max-updates override reaches the
+/// learner as its flag. In reproducible mode the learner and the actors get --reproducible and
+/// --round-weights-every-steps, the learner --snapshot-dir <run>/snapshots and
+/// --snapshot-every-updates (run.best_eval_every_updates), and a restarted actor keeps its seed.
 std::vector<RoleSpec> make_roles(const RunContext& ctx,
                                  const std::vector<std::string>& transport_args);
 
