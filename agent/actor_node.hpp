@@ -99,6 +99,8 @@ struct ActorCounters {
   std::int64_t rounds_sent = 0;       ///< reproducible mode
   std::int64_t rounds_abandoned = 0;  ///< reproducible mode: the learner had moved elsewhere
   std::int64_t rounds_resent = 0;     ///< reproducible mode: sent again, not taken in time
+  double round_start_wait_s = 0.0;    ///< reproducible mode: waiting for a round to start
+  double round_step_wait_s = 0.0;     ///< reproducible mode: waiting for weights mid-round
 };
 
 /// The actor as a transport participant. Single-threaded.
@@ -193,6 +195,7 @@ class ActorNode {
   std::vector<auvrl_lcm::experience_batch_t> sent_;  ///< kept until the learner takes it
   std::chrono::steady_clock::time_point round_progress_;
   std::chrono::steady_clock::time_point round_request_;
+  std::chrono::steady_clock::time_point waiting_since_;  ///< for weights mid-round
   std::deque<auvrl_lcm::policy_weights_t> weights_queue_;
   transport::SubscriptionId weights_subscription_ = -1;
 

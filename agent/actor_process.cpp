@@ -72,7 +72,8 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
       << c.episodes_discarded << " discarded";
   if (config.reproducible) {
     log << ", " << c.rounds_sent << " rounds sent, " << c.rounds_resent << " sent again, "
-        << c.rounds_abandoned << " abandoned";
+        << c.rounds_abandoned << " abandoned, waited " << c.round_start_wait_s
+        << " s for rounds to start and " << c.round_step_wait_s << " s for weights within them";
   }
   log << "\n";
 }

@@ -82,6 +82,12 @@ void ActorNode::request_round_weights(std::int64_t round, std::int32_t index) {
 }
 
 bool ActorNode::await_round_start() {
+  const auto start = Clock::now();
+  struct Count {
+    Clock::time_point start;
+    double& waited_s;
+    ~Count() { waited_s += seconds_since(start); }
+  } count{start, counters_.round_start_wait_s};
   for (;;) {
     pump_weights();
     if (learner_done_) return false;
@@ -104,7 +110,8 @@ bool ActorNode::await_round_start() {
 
 void ActorNode::use_round_weights(std::int64_t step) {
   const auto want = static_cast<std::int32_t>(step / config_.round_weights_every_steps);
-  for (;;) {
+  for (bool first = true;; first = false) {
+    if (!first && waiting_since_ == Clock::time_point{}) waiting_since_ = Clock::now();
     pump_weights();
     if (round_abandoned_ || learner_done_) throw RoundAbandoned{};
     auto it = round_weights_.find(want);
@@ -113,6 +120,10 @@ void ActorNode::use_round_weights(std::int64_t step) {
       if (newest.round_final && newest.round_index < want) it = std::prev(round_weights_.end());
     }
     if (it != round_weights_.end()) {
+      if (waiting_since_ != Clock::time_point{}) {
+        counters_.round_step_wait_s += seconds_since(waiting_since_);
+        waiting_since_ = {};
+      }
       if (it->first == applied_index_) return;
       std::string error;
       switch (policy_.apply(it->second, error)) {

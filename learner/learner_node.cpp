@@ -501,6 +501,8 @@ void LearnerNode::publish_stats() {
 }
 
 void LearnerNode::poll(int timeout_ms) {
+  // A round completed by the last poll's messages starts now, not after the wait below.
+  if (config_.reproducible && !training_done()) take_round_if_complete();
   const bool owed = config_.reproducible ? round_updates_done_ < round_updates_owed_
                                          : update_credit_ >= 1.0;
   const bool can_update = owed && !training_done();
