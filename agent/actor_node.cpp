@@ -240,7 +240,7 @@ std::vector<auvrl_lcm::experience_batch_t> ActorNode::experience_messages(
     msg.state_dim = state_dim;
     msg.action_dim = action_dim;
     msg.num_transitions = static_cast<std::int32_t>(end - begin);
-    msg.round = -1;
+    msg.round = 0;  // the asynchronous mode
     msg.expert_rows = config_.expert ? msg.num_transitions : 0;
     for (std::size_t i = begin; i < end; ++i) {
       const Transition& t = transitions[i];

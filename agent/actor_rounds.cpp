@@ -35,11 +35,15 @@ void ActorNode::seed_round(std::int64_t round) {
   conditions_rng_.seed(stream_seed(config_.seed, round, 3));
   demonstration_rng_.seed(stream_seed(config_.seed, round, 4));
   noise_.reseed(stream_seed(config_.seed, round, 5));
-  episode_id_ = round + 1;  // also seeds the simulator's own noise (EpisodeOptions::start)
+  episode_id_ = round;  // also seeds the simulator's own noise (EpisodeOptions::start)
 }
 
 void ActorNode::on_round_weights(const auvrl_lcm::policy_weights_t& msg) {
-  if (msg.round < -1 || msg.round_index < 0) return;  // not of the reproducible mode
+  if (msg.round < 0 || msg.round_index < 0) {
+    throw UnrecoverableFault(
+        "the learner publishes weights of the asynchronous mode; this actor is reproducible "
+        "(every process of a run must be started with --reproducible, or none)");
+  }
   learner_done_ = learner_done_ || msg.training_done;
   learner_round_ = msg.round;
   round_progress_ = Clock::now();

@@ -9,7 +9,7 @@
 
 namespace auvrl {
 
-/// Round r is one episode of every actor. The learner takes round r of every actor, in actor
+/// Round r (1, 2, ...) is one episode of every actor. The learner takes round r of every actor, in actor
 /// order, then owes it U_r updates (updates_per_transition per transition past the warm-up,
 /// the fraction carried over). While it works them off it publishes the weights of round r at
 /// index k = 0, 1, ... after updates_for_index(k) of them, and a final index after all U_r.

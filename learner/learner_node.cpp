@@ -76,8 +76,8 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
       throw std::invalid_argument("snapshot_every_updates and checkpoint_every_updates must be >= 0");
     }
     collector_ = std::make_unique<RoundCollector>(config_.max_actors);
-    // Round -1 has no experience: its only weights are the initial networks'.
-    round_weights_.begin(-1);
+    // Round 0 has no experience: its only weights are the initial networks'.
+    round_weights_.begin(0);
     round_updates_owed_ = round_updates_done_ = 0;
     record_round_weights(true);  // published at the first poll (broadcast_requested_)
   }
@@ -210,11 +210,11 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
     ++counters_.dropped_unknown_actor;
     return;
   }
-  if ((msg.round >= 0) != config_.reproducible && unrecoverable_.empty()) {
+  if ((msg.round >= 1) != config_.reproducible && unrecoverable_.empty()) {
     // No restart mends a mix of modes: the launcher starts every process in the same one.
     unrecoverable_ = fmt::format(
         "actor {} sends {} experience but this learner runs in the {} mode", msg.actor_id,
-        msg.round >= 0 ? "reproducible (rounds of)" : "asynchronous",
+        msg.round >= 1 ? "reproducible (rounds of)" : "asynchronous",
         config_.reproducible ? "reproducible" : "asynchronous");
     return;
   }
