@@ -3,16 +3,16 @@
 // transitions to the learner and a report of every episode.
 #pragma once
 
-#include <auvrl_lcm/policy_weights_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
+#include <auvrl_lcm/policy_weights_t.hpp>
 #include <chrono>
 #include <cstdint>
 #include <deque>
 #include <map>
-#include <vector>
 #include <memory>
 #include <ostream>
 #include <random>
+#include <vector>
 
 #include "agent/controller.hpp"
 #include "agent/episode.hpp"
@@ -95,7 +95,7 @@ struct ActorCounters {
   std::int64_t weights_applied = 0;
   std::int64_t weights_rejected = 0;  ///< checksum, format or size mismatch
   std::int64_t weights_requests = 0;
-  double waited_s = 0.0;  ///< time spent waiting for the learner (flow control)
+  double waited_s = 0.0;              ///< time spent waiting for the learner (flow control)
   std::int64_t rounds_sent = 0;       ///< reproducible mode
   std::int64_t rounds_abandoned = 0;  ///< reproducible mode: the learner had moved elsewhere
   std::int64_t rounds_resent = 0;     ///< reproducible mode: sent again, not taken in time

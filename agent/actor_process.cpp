@@ -46,7 +46,7 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
          (config.max_episodes == 0 || node.counters().episodes < config.max_episodes)) {
     const EpisodeSummary s = node.run_one_episode();
     if (s.length_steps == 0 && node.training_done()) break;  // ended while it waited
-    if (node.last_was_demonstration()) continue;  // the window is the policy's
+    if (node.last_was_demonstration()) continue;             // the window is the policy's
     return_sum += s.episode_return;
     successes += s.success ? 1 : 0;
     if (node.last_conditions().kinds != 0) {

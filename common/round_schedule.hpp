@@ -9,8 +9,8 @@
 
 namespace auvrl {
 
-/// Round r (1, 2, ...) is one episode of every actor. The learner takes round r of every actor, in actor
-/// order, then owes it U_r updates (updates_per_transition per transition past the warm-up,
+/// Round r (1, 2, ...) is one episode of every actor. The learner takes round r of every actor, in
+/// actor order, then owes it U_r updates (updates_per_transition per transition past the warm-up,
 /// the fraction carried over). While it works them off it publishes the weights of round r at
 /// index k = 0, 1, ... after updates_for_index(k) of them, and a final index after all U_r.
 /// An actor acts in round r + 1 with the weights of round r: at its step j of the round, index
@@ -36,8 +36,8 @@ struct RoundSchedule {
   /// The learner's updates of a round after which index k is published: every actor's steps
   /// up to that index produce that many updates between them.
   std::int64_t updates_for_index(std::int64_t k) const {
-    return static_cast<std::int64_t>(std::ceil(static_cast<double>(k) * weights_every_steps *
-                                               actors * updates_per_transition));
+    return static_cast<std::int64_t>(
+        std::ceil(static_cast<double>(k) * weights_every_steps * actors * updates_per_transition));
   }
 };
 

@@ -1,5 +1,7 @@
 #include "launcher/run_directory.hpp"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <ctime>
 #include <filesystem>
@@ -64,6 +66,7 @@ void write_readme(const std::string& run_dir) {
   std::ofstream howto(fs::path(run_dir) / "README.txt");
   howto << "auvrl run directory\n"
         << "  config.yaml       the configuration of this run\n"
+        << "  command_line.yaml the settings the command line gave it (--resume keeps them)\n"
         << "  progress.csv      training progress (also on the terminal)\n"
         << "  episodes.csv      one row per episode; learner.csv: the learner's figures\n"
         << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
@@ -81,12 +84,70 @@ void write_readme(const std::string& run_dir) {
 
 }  // namespace
 
+namespace {
+
+constexpr const char* kCommandLineFile = "command_line.yaml";
+
+/// The settings the command line gave a new run, so that --resume continues it the same way.
+void write_command_line(const TrainOptions& o) {
+  YAML::Emitter out;
+  out << YAML::BeginMap;
+  if (o.actors >= 0) out << YAML::Key << "actors" << YAML::Value << o.actors;
+  if (o.max_train_s >= 0) out << YAML::Key << "max_seconds" << YAML::Value << o.max_train_s;
+  if (o.seed >= 0) out << YAML::Key << "seed" << YAML::Value << o.seed;
+  if (o.reproducible) out << YAML::Key << "reproducible" << YAML::Value << true;
+  if (o.max_updates >= 0) out << YAML::Key << "max_updates" << YAML::Value << o.max_updates;
+  if (o.finetune_iterations >= 0) {
+    out << YAML::Key << "finetune_iterations" << YAML::Value << o.finetune_iterations;
+  }
+  if (!o.transport_args.empty()) {
+    out << YAML::Key << "transport_args" << YAML::Value << YAML::Flow << o.transport_args;
+  }
+  out << YAML::EndMap;
+  std::ofstream file(fs::path(o.run_dir) / kCommandLineFile);
+  file << "# The settings auvrl train's command line gave this run; --resume applies them again\n"
+          "# unless it is given others.\n"
+       << out.c_str() << "\n";
+  if (!file) throw std::runtime_error("cannot write " + o.run_dir + "/" + kCommandLineFile);
+}
+
+/// --resume: the run's own command-line settings, where this command line gives none.
+void restore_command_line(TrainOptions& o) {
+  const fs::path path = fs::path(o.run_dir) / kCommandLineFile;
+  if (!fs::exists(path)) return;  // a run from before this file, or given no settings
+  try {
+    const YAML::Node saved = YAML::LoadFile(path.string());
+    if (!saved.IsMap()) throw std::runtime_error("not a map");
+    if (o.actors < 0 && saved["actors"]) o.actors = saved["actors"].as<int>();
+    if (o.max_train_s < 0 && saved["max_seconds"]) {
+      o.max_train_s = saved["max_seconds"].as<double>();
+    }
+    if (o.seed < 0 && saved["seed"]) o.seed = saved["seed"].as<std::int64_t>();
+    if (saved["reproducible"]) o.reproducible = o.reproducible || saved["reproducible"].as<bool>();
+    if (o.max_updates < 0 && saved["max_updates"]) {
+      o.max_updates = saved["max_updates"].as<std::int64_t>();
+    }
+    if (o.finetune_iterations < 0 && saved["finetune_iterations"]) {
+      o.finetune_iterations = saved["finetune_iterations"].as<int>();
+    }
+    if (o.transport_args.empty() && saved["transport_args"]) {
+      o.transport_args = saved["transport_args"].as<std::vector<std::string>>();
+    }
+  } catch (const std::exception& e) {
+    throw std::runtime_error(path.string() + ": " + e.what() +
+                             " (the settings auvrl train's command line gave this run)");
+  }
+}
+
+}  // namespace
+
 std::string prepare_run_directory(TrainOptions& o) {
   const std::string config_copy = (fs::path(o.run_dir) / "config.yaml").string();
   if (o.resume) {
     if (!fs::is_regular_file(config_copy)) {
       throw std::runtime_error("--resume " + o.run_dir + ": no config.yaml there (not a run)");
     }
+    restore_command_line(o);
     return config_copy;
   }
   if (o.config_path.empty() || !fs::is_regular_file(o.config_path)) {
@@ -110,6 +171,7 @@ std::string prepare_run_directory(TrainOptions& o) {
   }
   if (!o.vehicle_path.empty()) sim::load_vehicle_file(o.vehicle_path);  // fails here, early
   copy_config(o.config_path, o.vehicle_path, o.run_dir);
+  write_command_line(o);
   write_readme(o.run_dir);
   return (fs::path(o.run_dir) / "config.yaml").string();
 }

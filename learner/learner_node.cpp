@@ -3,11 +3,10 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
-#include <filesystem>
-
 #include <algorithm>
 #include <auvrl_lcm/policy_summary_t.hpp>
 #include <cmath>
+#include <filesystem>
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
@@ -73,7 +72,8 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
                        config_.updates_per_transition};
     round_schedule_.validate();
     if (config_.snapshot_every_updates < 0 || config_.checkpoint_every_updates < 0) {
-      throw std::invalid_argument("snapshot_every_updates and checkpoint_every_updates must be >= 0");
+      throw std::invalid_argument(
+          "snapshot_every_updates and checkpoint_every_updates must be >= 0");
     }
     collector_ = std::make_unique<RoundCollector>(config_.max_actors);
     // Round 0 has no experience: its only weights are the initial networks'.
@@ -146,9 +146,8 @@ bool LearnerNode::sound_batch(const auvrl_lcm::experience_batch_t& msg) {
       (n < 1 && !empty_ok) || n > config_.max_transitions_per_batch ||
       !rows_ok(msg.states, msg.state_dim) || !rows_ok(msg.next_states, msg.state_dim) ||
       !rows_ok(msg.actions, msg.action_dim) || !rows_ok(msg.achieved_position_ned_m, 3) ||
-      !rows_ok(msg.goal_ned_m, 3) ||
-      static_cast<int>(msg.rewards.size()) != n || static_cast<int>(msg.terminal.size()) != n ||
-      static_cast<int>(msg.episode_id.size()) != n ||
+      !rows_ok(msg.goal_ned_m, 3) || static_cast<int>(msg.rewards.size()) != n ||
+      static_cast<int>(msg.terminal.size()) != n || static_cast<int>(msg.episode_id.size()) != n ||
       static_cast<int>(msg.step_index.size()) != n ||
       (msg.expert_rows != 0 && !rows_ok(msg.expert_actions, msg.action_dim))) {
     ++counters_.dropped_dims;
@@ -212,10 +211,10 @@ void LearnerNode::on_experience(const auvrl_lcm::experience_batch_t& msg) {
   }
   if ((msg.round >= 1) != config_.reproducible && unrecoverable_.empty()) {
     // No restart mends a mix of modes: the launcher starts every process in the same one.
-    unrecoverable_ = fmt::format(
-        "actor {} sends {} experience but this learner runs in the {} mode", msg.actor_id,
-        msg.round >= 1 ? "reproducible (rounds of)" : "asynchronous",
-        config_.reproducible ? "reproducible" : "asynchronous");
+    unrecoverable_ =
+        fmt::format("actor {} sends {} experience but this learner runs in the {} mode",
+                    msg.actor_id, msg.round >= 1 ? "reproducible (rounds of)" : "asynchronous",
+                    config_.reproducible ? "reproducible" : "asynchronous");
     return;
   }
   if (!sound_batch(msg)) return;
@@ -386,8 +385,8 @@ void LearnerNode::answer_round_request(const auvrl_lcm::weights_request_t& msg) 
   }
   // Otherwise not yet published: it goes out when due.
   if (answer) {
-    publish_weights_message(round_weights_message(*answer, round_weights_.round(),
-                                                  training_done()));
+    publish_weights_message(
+        round_weights_message(*answer, round_weights_.round(), training_done()));
   }
 }
 
@@ -503,8 +502,8 @@ void LearnerNode::publish_stats() {
 void LearnerNode::poll(int timeout_ms) {
   // A round completed by the last poll's messages starts now, not after the wait below.
   if (config_.reproducible && !training_done()) take_round_if_complete();
-  const bool owed = config_.reproducible ? round_updates_done_ < round_updates_owed_
-                                         : update_credit_ >= 1.0;
+  const bool owed =
+      config_.reproducible ? round_updates_done_ < round_updates_owed_ : update_credit_ >= 1.0;
   const bool can_update = owed && !training_done();
   transport_.handle(can_update || broadcast_requested_ ? 0 : timeout_ms);
   if (!unrecoverable_.empty()) throw UnrecoverableFault(unrecoverable_);
@@ -587,8 +586,9 @@ void LearnerNode::resume() {
         replay->restore(r);
         const bool reproducible = version >= 2 && r.u8() != 0;
         if (reproducible != config_.reproducible) {
-          r.fail(reproducible ? "a checkpoint of the reproducible mode; this learner is asynchronous"
-                              : "a checkpoint of the asynchronous mode; this learner is reproducible");
+          r.fail(reproducible
+                     ? "a checkpoint of the reproducible mode; this learner is asynchronous"
+                     : "a checkpoint of the asynchronous mode; this learner is reproducible");
         }
         RoundState round;
         if (reproducible) round = read_round_state(r);
@@ -597,7 +597,8 @@ void LearnerNode::resume() {
         replay_ = std::move(replay);
         counters_.episodes = episodes;
         counters_.transitions_received = transitions;
-        update_credit_ = reproducible ? credit : std::clamp(credit, 0.0, config_.max_update_backlog);
+        update_credit_ =
+            reproducible ? credit : std::clamp(credit, 0.0, config_.max_update_backlog);
         if (reproducible) restore_round_state(std::move(round));
         seqs.resize(static_cast<std::size_t>(config_.max_actors), -1);
         last_batch_seq_ = std::move(seqs);

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "common/round_schedule.hpp"
 #include "common/task/goal_schedule.hpp"
 #include "common/task/task.hpp"
 #include "common/transport.hpp"
@@ -22,7 +23,6 @@
 #include "learner/hindsight.hpp"
 #include "learner/replay_buffer.hpp"
 #include "learner/rounds.hpp"
-#include "common/round_schedule.hpp"
 
 namespace auvrl::learner {
 
@@ -62,7 +62,7 @@ struct LearnerNodeConfig {
   std::int64_t max_episodes = 0;  ///< training ends after this many episodes (0: never)
   std::int64_t max_updates = 0;   ///< or after this many updates (0: never)
 
-  std::string checkpoint_dir;  ///< empty: no checkpoints
+  std::string checkpoint_dir;          ///< empty: no checkpoints
   double checkpoint_period_s = 300.0;  ///< asynchronous mode
   /// Reproducible mode: a checkpoint after every this many updates (0: none but the last).
   std::int64_t checkpoint_every_updates = 100000;

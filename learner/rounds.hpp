@@ -20,10 +20,10 @@ class RoundCollector {
 
   /// What offer() did with a batch.
   enum class Offer {
-    kStored,     ///< kept for the awaited round
-    kDuplicate,  ///< that batch of that actor's round is already held (a resend)
-    kOtherRound, ///< of a round already taken, or not yet awaited: dropped
-    kMalformed,  ///< round_batch or round_batches out of range, or not as the actor said before
+    kStored,      ///< kept for the awaited round
+    kDuplicate,   ///< that batch of that actor's round is already held (a resend)
+    kOtherRound,  ///< of a round already taken, or not yet awaited: dropped
+    kMalformed,   ///< round_batch or round_batches out of range, or not as the actor said before
   };
   /// Offers a batch (already checked for sizes and values) of msg.round; `awaited` is the round
   /// the learner takes next.

@@ -1,7 +1,8 @@
 // auvrl train --reproducible through the real processes (inside this test's private network
 // namespace): the same seed gives byte-identical checkpoints, policies and evaluation, another
-// seed does not, and a run whose learner or actor is killed with SIGKILL and comes back ends
-// with the same bytes as the run left alone. Over LCM with one actor and two, and over DDS.
+// seed does not, and a run whose learner or actor is killed with SIGKILL and comes back, or
+// that is stopped with Ctrl-C and resumed, ends with the same bytes as the run left alone. Over
+// LCM with one actor and two, and over DDS.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -77,37 +78,80 @@ struct RunSpec {
 
 class ReproducibleRun : public ::testing::TestWithParam<std::pair<std::string, int>> {
  protected:
+  /// auvrl train --reproducible's command line for a new run.
+  static std::vector<std::string> train_command(const std::string& tmp, const fs::path& run,
+                                                const RunSpec& spec) {
+    return {test_support::bin_path("auvrl"),
+            "train",
+            "--config",
+            short_config(tmp),
+            "--run-dir",
+            run.string(),
+            "--network",
+            "host",
+            "--reproducible",
+            "--max-updates",
+            std::to_string(kMaxUpdates),
+            "--seed",
+            std::to_string(spec.seed),
+            "--actors",
+            std::to_string(spec.actors),
+            "--finetune-iterations",
+            "4",
+            "--transport",
+            spec.transport};
+  }
+
   /// Runs auvrl train --reproducible to the end; returns the run directory.
   fs::path train(const std::string& tmp, const std::string& name, const RunSpec& spec) {
     const fs::path run = fs::path(tmp) / name;
-    ChildProcess train({test_support::bin_path("auvrl"), "train", "--config", short_config(tmp),
-                        "--run-dir", run.string(), "--network", "host", "--reproducible",
-                        "--max-updates", std::to_string(kMaxUpdates), "--seed",
-                        std::to_string(spec.seed), "--actors", std::to_string(spec.actors),
-                        "--finetune-iterations", "4", "--transport", spec.transport},
-                       run.string() + ".log");
+    ChildProcess train(train_command(tmp, run, spec), run.string() + ".log");
     if (!spec.kill.empty()) kill_once_under_way(run, spec.kill, train);
     const int status = train.wait_for_exit(std::chrono::seconds(240));
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << train.log();
     return run;
   }
 
+  /// Stops a run with Ctrl-C once the learner has checkpointed, then continues it with
+  /// `auvrl train --resume RUN` alone (the run keeps its command line's settings).
+  fs::path interrupt_and_resume(const std::string& tmp, const std::string& name,
+                                const RunSpec& spec) {
+    const fs::path run = fs::path(tmp) / name;
+    {
+      ChildProcess train(train_command(tmp, run, spec), run.string() + ".log");
+      EXPECT_TRUE(wait_for([&] { return has_checkpoint(run); }, 120)) << train.log();
+      train.signal(SIGINT);
+      const int status = train.wait_for_exit(std::chrono::seconds(120));
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 130) << train.log();
+    }
+    ChildProcess resume(
+        {test_support::bin_path("auvrl"), "train", "--resume", run.string(), "--network", "host"},
+        run.string() + ".resume.log");
+    const int status = resume.wait_for_exit(std::chrono::seconds(240));
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << resume.log();
+    EXPECT_NE(read_text(run / "processes" / "learner.log").find("resumed from"), std::string::npos);
+    return run;
+  }
+
+  static bool has_checkpoint(const fs::path& run) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(run / "checkpoints", ec)) {
+      if (e.path().extension() == ".ckpt") return true;
+    }
+    return false;
+  }
+
   /// Kills `role` with SIGKILL once the learner has written a checkpoint (the learner then
   /// resumes from it; the actor comes back as the same actor) and checks it came back.
   void kill_once_under_way(const fs::path& run, const std::string& role, ChildProcess& train) {
-    const auto checkpoint = [&] {
-      std::error_code ec;
-      for (const auto& e : fs::directory_iterator(run / "checkpoints", ec)) {
-        if (e.path().extension() == ".ckpt") return true;
-      }
-      return false;
-    };
-    ASSERT_TRUE(wait_for(checkpoint, 120)) << train.log();
+    ASSERT_TRUE(wait_for([&] { return has_checkpoint(run); }, 120)) << train.log();
     const int pid = read_pid(run / "processes" / (role + ".pid"));
     ASSERT_GT(pid, 0);
     ASSERT_EQ(kill(pid, SIGKILL), 0);
     ASSERT_TRUE(wait_for(
-        [&] { return train.log().find(role + " ended (signal 9); restarting") != std::string::npos; },
+        [&] {
+          return train.log().find(role + " ended (signal 9); restarting") != std::string::npos;
+        },
         30))
         << train.log();
     if (role == "learner") {
@@ -143,6 +187,9 @@ TEST_P(ReproducibleRun, SameSeedSameBytesAlsoAfterAKilledLearnerOrActor) {
   const RunBytes actor = run_bytes(train(tmp, "actor", {transport, actors, 1, "actor0"}));
   expect_same_bytes(alone, actor, "an actor killed and restarted");
   if (transport == "lcm" && actors == 1) {
+    const RunBytes stopped =
+        run_bytes(interrupt_and_resume(tmp, "stopped", {transport, actors, 1, ""}));
+    expect_same_bytes(alone, stopped, "stopped with Ctrl-C and resumed");
     const RunBytes other = run_bytes(train(tmp, "other", {transport, actors, 2, ""}));
     EXPECT_FALSE(other.policy.empty());
     EXPECT_TRUE(other.policy != alone.policy) << "seed 2 gave seed 1's policy";

@@ -124,6 +124,37 @@ TEST_F(ReproducibleRunTest, TheBudgetIsCheckedForTrainingOnly) {
   EXPECT_NO_THROW(check_reproducible_budget(episodes));
 }
 
+TEST_F(ReproducibleRunTest, ResumeKeepsTheSettingsTheCommandLineGaveTheRun) {
+  options.reproducible = true;
+  options.max_updates = 5000;
+  options.seed = 7;
+  options.actors = 2;
+  options.transport_args = {"--transport", "dds"};
+  prepare_run_directory(options);
+  TrainOptions resume;
+  resume.run_dir = options.run_dir;
+  resume.resume = true;
+  resume.seed = 9;  // given again: this one counts
+  prepare_run_directory(resume);
+  EXPECT_TRUE(resume.reproducible);
+  EXPECT_EQ(resume.max_updates, 5000);
+  EXPECT_EQ(resume.seed, 9);
+  EXPECT_EQ(resume.actors, 2);
+  EXPECT_EQ(resume.transport_args, (std::vector<std::string>{"--transport", "dds"}));
+  EXPECT_EQ(resume.max_train_s, -1);  // never given
+
+  std::ofstream(fs::path(options.run_dir) / "command_line.yaml") << "seed: [1, 2]\n";
+  TrainOptions broken;
+  broken.run_dir = options.run_dir;
+  broken.resume = true;
+  try {
+    prepare_run_directory(broken);
+    FAIL() << "expected an error naming command_line.yaml";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("command_line.yaml"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(ReproducibleRunTest, TheInnerCommandPassesTheModeAndTheBudgetOn) {
   options.source_dir = "/src";
   options.bin_dir = "/bin";

@@ -164,8 +164,8 @@ TEST(ReproducibleLearnerNode, TakesARoundInActorOrderWhateverTheArrivalOrder) {
     EXPECT_EQ(a.weights[i].round, 1);
     indices.emplace_back(a.weights[i].round_index, a.weights[i].round_final);
   }
-  EXPECT_EQ(indices, (std::vector<std::pair<int, bool>>{{0, false}, {1, false}, {2, false},
-                                                         {3, true}}));
+  EXPECT_EQ(indices,
+            (std::vector<std::pair<int, bool>>{{0, false}, {1, false}, {2, false}, {3, true}}));
   // Asked again, index 1 comes again; an index not yet due does not.
   auvrl_lcm::weights_request_t req{};
   req.actor_id = 0;
