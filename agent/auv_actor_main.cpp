@@ -8,6 +8,7 @@
 #include "agent/actor_process.hpp"
 #include "common/cli.hpp"
 #include "common/config/table.hpp"
+#include "common/round_schedule.hpp"
 #include "common/transport_options.hpp"
 #include "common/unrecoverable.hpp"
 
@@ -41,11 +42,7 @@ int main(int argc, char** argv) {
   cmd.option("seed", &options.seed, "seed of way-points and noise (give each actor its own)");
   cmd.option("pin-cpu", &options.pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &options.report_every, "a log line every N episodes");
-  cmd.flag("reproducible", &config.reproducible,
-           "reproducible mode: rounds numbered by the learner, weights by round, every draw from "
-           "the seed and the round (common/round_schedule.hpp)");
-  cmd.option("round-weights-every-steps", &config.round_weights_every_steps,
-             "reproducible mode: steps per weights index (the learner's setting)");
+  add_reproducible_options(cmd, &config.reproducible, &config.round_weights_every_steps);
   cmd.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the run file's vehicle:, else config/vehicles/nessie7.yaml)");
   transport::add_transport_options(cmd, transport_config);

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <stdexcept>
 
+#include "common/cli.hpp"
+
 namespace auvrl {
 
 /// Round r (1, 2, ...) is one episode of every actor. The learner takes round r of every actor, in
@@ -40,5 +42,16 @@ struct RoundSchedule {
         std::ceil(static_cast<double>(k) * weights_every_steps * actors * updates_per_transition));
   }
 };
+
+/// The reproducible mode's flags, the same for auv_learner and auv_actor: --reproducible and
+/// --round-weights-every-steps (RoundSchedule::weights_every_steps).
+inline void add_reproducible_options(cli::CommandLine& cmd, bool* reproducible,
+                                     int* weights_every_steps) {
+  cmd.flag("reproducible", reproducible,
+           "reproducible mode: experience in rounds numbered by the learner, weights by round and "
+           "index, every period counted (common/round_schedule.hpp); every process or none");
+  cmd.option("round-weights-every-steps", weights_every_steps,
+             "reproducible mode: an actor's steps per weights index (the same for every process)");
+}
 
 }  // namespace auvrl

@@ -5,6 +5,7 @@
 
 #include "common/cli.hpp"
 #include "common/config/table.hpp"
+#include "common/round_schedule.hpp"
 #include "common/task/task_yaml.hpp"
 #include "common/transport_options.hpp"
 #include "common/unrecoverable.hpp"
@@ -45,11 +46,7 @@ int main(int argc, char** argv) {
   cmd.option("hidden", &options.hidden, "hidden sizes of both networks, e.g. 400-300");
   cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
   cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
-  cmd.flag("reproducible", &config.reproducible,
-           "reproducible mode: experience in rounds from exactly --max-actors actors, weights by "
-           "round, periods in updates (common/round_schedule.hpp)");
-  cmd.option("round-weights-every-steps", &config.round_weights_every_steps,
-             "reproducible mode: an actor's steps per weights index");
+  add_reproducible_options(cmd, &config.reproducible, &config.round_weights_every_steps);
   cmd.option("snapshot-dir", &config.snapshot_dir,
              "reproducible mode: the actor network is written here every --snapshot-every-updates");
   cmd.option("snapshot-every-updates", &config.snapshot_every_updates,

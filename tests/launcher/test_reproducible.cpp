@@ -14,6 +14,7 @@
 #include "child_process.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/nn/serialize.hpp"
+#include "find_role.hpp"
 #include "launcher/best_policy.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/run_config.hpp"
@@ -185,11 +186,8 @@ class ReproducibleRolesTest : public ::testing::Test {
     ctx.cpus = 4;
     ctx.actors = 2;
   }
-  const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
-    for (const auto& r : roles) {
-      if (r.name == name) return r;
-    }
-    throw std::runtime_error("no role " + name);
+  static const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
+    return test_support::find_role(roles, name);
   }
   RunContext ctx;
 };

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "child_process.hpp"
+#include "find_role.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/refinetune.hpp"
@@ -130,11 +131,8 @@ class RolesTest : public ::testing::Test {
     ctx.cpus = 4;
     ctx.actors = 2;
   }
-  const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
-    for (const auto& r : roles) {
-      if (r.name == name) return r;
-    }
-    throw std::runtime_error("no role " + name);
+  static const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
+    return test_support::find_role(roles, name);
   }
   RunContext ctx;
 };
