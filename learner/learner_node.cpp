@@ -146,9 +146,7 @@ bool LearnerNode::sound_batch(const auvrl_lcm::experience_batch_t& msg) {
       (n < 1 && !empty_ok) || n > config_.max_transitions_per_batch ||
       !rows_ok(msg.states, msg.state_dim) || !rows_ok(msg.next_states, msg.state_dim) ||
       !rows_ok(msg.actions, msg.action_dim) || !rows_ok(msg.achieved_position_ned_m, 3) ||
-      !rows_ok(msg.goal_ned_m, 3) || static_cast<int>(msg.rewards.size()) != n ||
-      static_cast<int>(msg.terminal.size()) != n || static_cast<int>(msg.episode_id.size()) != n ||
-      static_cast<int>(msg.step_index.size()) != n ||
+      !rows_ok(msg.goal_ned_m, 3) ||
       (msg.expert_rows != 0 && !rows_ok(msg.expert_actions, msg.action_dim))) {
     ++counters_.dropped_dims;
     return false;
