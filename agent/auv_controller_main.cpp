@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
   cmd.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the mission's vehicle:, else config/vehicles/nessie7.yaml)");
   cmd.option("layout", &options.layout, "state layout (default: inferred from the policy)");
+  cmd.option("trust-key", &options.trust_key,
+             "Ed25519 public key (PEM): the mission and the policy must be signed by its private "
+             "key (FILE.sig beside each; auvrl sign), else they are refused");
   cmd.option("vehicle-id", &options.vehicle_id, "its vehicle's id (SIM_STATE_<id>)");
   cmd.option("stale-steps", &options.stale_steps,
              "control steps without a state that stop the thrusters");

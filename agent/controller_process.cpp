@@ -8,12 +8,20 @@
 #include "agent/pid_controller.hpp"
 #include "agent/pid_gains.hpp"
 #include "common/signals.hpp"
+#include "common/signature.hpp"
 #include "common/vehicle_facts.hpp"
 
 namespace auvrl::agent {
 
 ControllerSetup load_controller_setup(const ControllerProcessOptions& options) {
   if (options.mission_path.empty()) throw std::invalid_argument("--mission FILE is required");
+  if (!options.trust_key.empty()) {
+    // Before anything of them is read: an unsigned or altered file is refused, named.
+    signature::verify_file(options.mission_path, options.trust_key);
+    if (options.controller == "policy" && !options.policy_path.empty()) {
+      signature::verify_file(options.policy_path, options.trust_key);
+    }
+  }
   ControllerSetup setup{{}, {}, nullptr, read_mission_file(options.mission_path)};
   const std::string vehicle = !options.vehicle_path.empty()         ? options.vehicle_path
                               : !setup.mission.vehicle_path.empty() ? setup.mission.vehicle_path

@@ -19,6 +19,9 @@ struct ControllerProcessOptions {
   std::string controller = "policy";  ///< "policy" or "pid"
   std::string vehicle_path;           ///< "": the mission's vehicle:, else default_vehicle_file()
   std::string layout;                 ///< "": inferred from the policy's input size
+  /// An Ed25519 public key (PEM): the mission and the policy must then be signed by its
+  /// private key (FILE.sig beside each, common/signature.hpp), or they are refused.
+  std::string trust_key;
   int vehicle_id = 0;
   int stale_steps = 3;
   double speed = 1.0;  ///< the vehicle runs this many times faster than real time

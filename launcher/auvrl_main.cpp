@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/cli.hpp"
+#include "common/signature.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/mission_run.hpp"
@@ -331,6 +332,52 @@ int run_config_doc(int argc, const char* const* argv) {
   return 0;
 }
 
+int run_keygen(int argc, const char* const* argv) {
+  std::string prefix;
+  auvrl::cli::CommandLine cli("auvrl keygen",
+                              "Writes a new Ed25519 key pair: PREFIX.key (private, mode 0600) and "
+                              "PREFIX.pub (public: give it to auv_controller --trust-key).");
+  cli.option("out", &prefix, "PREFIX of the two files");
+  cli.require("out");
+  if (!cli.parse(argc, argv)) return 0;
+  auvrl::signature::generate_key_pair(prefix + ".key", prefix + ".pub");
+  std::cout << "auvrl keygen: " << prefix << ".key (keep it private), " << prefix << ".pub\n";
+  return 0;
+}
+
+int run_sign(int argc, const char* const* argv) {
+  std::string key;
+  std::vector<std::string> files;
+  auvrl::cli::CommandLine cli("auvrl sign",
+                              "Signs policy or mission files with an Ed25519 private key: FILE.sig "
+                              "beside each (docs/deployment.md).");
+  cli.option("key", &key, "the private key (PEM; auvrl keygen)");
+  cli.require("key");
+  cli.positionals("files", &files, "the files to sign");
+  if (!cli.parse(argc, argv)) return 0;
+  for (const std::string& f : files) {
+    std::cout << "auvrl sign: " << auvrl::signature::sign_file(f, key) << "\n";
+  }
+  return 0;
+}
+
+int run_verify(int argc, const char* const* argv) {
+  std::string key;
+  std::vector<std::string> files;
+  auvrl::cli::CommandLine cli("auvrl verify",
+                              "Checks files against their FILE.sig with an Ed25519 public key, as "
+                              "auv_controller --trust-key does; exit 1 at the first that fails.");
+  cli.option("trust-key", &key, "the public key (PEM)");
+  cli.require("trust-key");
+  cli.positionals("files", &files, "the files to check");
+  if (!cli.parse(argc, argv)) return 0;
+  for (const std::string& f : files) {
+    auvrl::signature::verify_file(f, key);
+    std::cout << "auvrl verify: " << f << ": signed by " << key << "\n";
+  }
+  return 0;
+}
+
 struct Subcommand {
   const char* name;
   const char* summary;
@@ -354,6 +401,9 @@ const Subcommand kSubcommands[] = {
     {"tune-pid", "tune the PID baseline's gains for a vehicle (X.yaml -> X.pid.yaml)",
      run_tune_pid},
     {"config-doc", "print the configuration reference (docs/configuration.md)", run_config_doc},
+    {"keygen", "write an Ed25519 key pair for signing policies and missions", run_keygen},
+    {"sign", "sign policy or mission files (FILE.sig) for auv_controller --trust-key", run_sign},
+    {"verify", "check files against their signatures with a public key", run_verify},
 };
 
 }  // namespace

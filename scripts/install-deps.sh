@@ -10,7 +10,9 @@ packages=(
   build-essential cmake pkg-config
   # libraries
   libeigen3-dev libyaml-cpp-dev liblcm-dev libglib2.0-dev cyclonedds-dev
-  libcli11-dev libfmt-dev zlib1g-dev
+  libcli11-dev libfmt-dev zlib1g-dev libssl-dev
+  # signatures made or checked by hand (docs/deployment.md)
+  openssl
   # tests and benchmarks; the fuzz build (clang, libFuzzer)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # LCM tools, Java bindings for lcm-spy, DDS tools
