@@ -253,6 +253,9 @@ int run_mission_command(int argc, const char* const* argv) {
   cli.require("mission");
   cli.option("policy", &options.policy_path, "policy network file (the nn format)");
   cli.option("controller", &options.controller, "policy (with --policy) or pid");
+  cli.option("trust-key", &options.trust_key,
+             "Ed25519 public key: fly only a mission and policy signed by its private key "
+             "(auv_controller --trust-key; auvrl sign)");
   cli.choices("controller", {"policy", "pid"});
   cli.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the mission's vehicle:, else config/vehicles/nessie7.yaml)");

@@ -66,6 +66,7 @@ agent::ControllerProcessOptions controller_options(const MissionRunOptions& o,
   c.controller = o.controller;
   c.vehicle_path = o.vehicle_path;
   c.speed = o.speed;
+  c.trust_key = o.trust_key;
   return c;
 }
 
@@ -86,6 +87,7 @@ void check_mission_run(MissionRunOptions& o) {
   o.mission_path = absolute_path(o.mission_path);
   o.vehicle_path = absolute_path(o.vehicle_path);
   o.policy_path = absolute_path(o.policy_path);
+  o.trust_key = absolute_path(o.trust_key);
   // auv_controller's own checks (the policy fits the vehicle, the PID has gains).
   const agent::ControllerSetup setup =
       agent::load_controller_setup(controller_options(o, o.mission_path));
@@ -151,6 +153,7 @@ std::vector<std::string> mission_namespace_command(const MissionRunOptions& o) {
   } else {
     args.insert(args.end(), {"--policy", o.policy_path});
   }
+  if (!o.trust_key.empty()) args.insert(args.end(), {"--trust-key", o.trust_key});
   return args;
 }
 
@@ -323,6 +326,7 @@ void MissionSession::start_processes() {
   }
   argv.insert(argv.end(), {"--vehicle", options_.vehicle_path, "--speed",
                            fmt::format("{}", options_.speed), "--exit-when-finished"});
+  if (!options_.trust_key.empty()) argv.insert(argv.end(), {"--trust-key", options_.trust_key});
   controller_ = start("controller", argv);
   out_ << fmt::format(
       "auvrl run: mission '{}' ({} way-points, time limit {:g} s) with {} on {} at x{:g}, run "

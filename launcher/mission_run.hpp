@@ -20,9 +20,11 @@ struct MissionRunOptions {
   std::string mission_path;           ///< the mission file (required)
   std::string policy_path;            ///< the policy's network file (controller "policy")
   std::string controller = "policy";  ///< "policy" or "pid"
-  std::string vehicle_path;           ///< "": the mission's vehicle:, else Nessie VII
-  double speed = 1.0;                 ///< the vehicle runs this many times faster than real time
-  std::string run_dir;                ///< "": SOURCE/runs/mission-<name>-<time>
+  /// auv_controller --trust-key: the mission and policy must be signed by its private key.
+  std::string trust_key;
+  std::string vehicle_path;  ///< "": the mission's vehicle:, else Nessie VII
+  double speed = 1.0;        ///< the vehicle runs this many times faster than real time
+  std::string run_dir;       ///< "": SOURCE/runs/mission-<name>-<time>
   /// run_dir was prepared by this command before it entered the network namespace.
   bool prepared = false;
   std::string bin_dir;     ///< where auvrl, auv_sim, auv_controller and auv_logger are
