@@ -5,6 +5,7 @@
 // a row to kSubcommands.
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -348,37 +349,42 @@ int run_keygen(int argc, const char* const* argv) {
   return 0;
 }
 
-int run_sign(int argc, const char* const* argv) {
+/// auvrl sign and auvrl verify: a key (--key_option) and files; `action` handles each file and
+/// says what it did.
+int run_key_and_files(
+    int argc, const char* const* argv, const char* program, const char* summary,
+    const char* key_option, const char* key_help,
+    const std::function<std::string(const std::string& file, const std::string& key)>& action) {
   std::string key;
   std::vector<std::string> files;
-  auvrl::cli::CommandLine cli("auvrl sign",
-                              "Signs policy or mission files with an Ed25519 private key: FILE.sig "
-                              "beside each (docs/deployment.md).");
-  cli.option("key", &key, "the private key (PEM; auvrl keygen)");
-  cli.require("key");
-  cli.positionals("files", &files, "the files to sign");
+  auvrl::cli::CommandLine cli(program, summary);
+  cli.option(key_option, &key, key_help);
+  cli.require(key_option);
+  cli.positionals("files", &files, "the files");
   if (!cli.parse(argc, argv)) return 0;
-  for (const std::string& f : files) {
-    std::cout << "auvrl sign: " << auvrl::signature::sign_file(f, key) << "\n";
-  }
+  for (const std::string& f : files) std::cout << program << ": " << action(f, key) << "\n";
   return 0;
 }
 
+int run_sign(int argc, const char* const* argv) {
+  return run_key_and_files(argc, argv, "auvrl sign",
+                           "Signs policy or mission files with an Ed25519 private key: FILE.sig "
+                           "beside each (docs/deployment.md).",
+                           "key", "the private key (PEM; auvrl keygen)",
+                           [](const std::string& file, const std::string& key) {
+                             return auvrl::signature::sign_file(file, key);
+                           });
+}
+
 int run_verify(int argc, const char* const* argv) {
-  std::string key;
-  std::vector<std::string> files;
-  auvrl::cli::CommandLine cli("auvrl verify",
-                              "Checks files against their FILE.sig with an Ed25519 public key, as "
-                              "auv_controller --trust-key does; exit 1 at the first that fails.");
-  cli.option("trust-key", &key, "the public key (PEM)");
-  cli.require("trust-key");
-  cli.positionals("files", &files, "the files to check");
-  if (!cli.parse(argc, argv)) return 0;
-  for (const std::string& f : files) {
-    auvrl::signature::verify_file(f, key);
-    std::cout << "auvrl verify: " << f << ": signed by " << key << "\n";
-  }
-  return 0;
+  return run_key_and_files(argc, argv, "auvrl verify",
+                           "Checks files against their FILE.sig with an Ed25519 public key, as "
+                           "auv_controller --trust-key does; exit 1 at the first that fails.",
+                           "trust-key", "the public key (PEM)",
+                           [](const std::string& file, const std::string& key) {
+                             auvrl::signature::verify_file(file, key);
+                             return file + ": signed by " + key;
+                           });
 }
 
 struct Subcommand {
