@@ -8,6 +8,7 @@
 #include "launcher/pipeline.hpp"
 #include "launcher/run_config.hpp"
 #include "launcher/run_directory.hpp"
+#include "launcher/run_signing.hpp"
 
 namespace auvrl::launcher {
 
@@ -52,6 +53,7 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   }
   out << "auvrl finetune: " << policy << " (run " << o.run_dir << ") into " << o.out_dir << "\n";
   const std::string kept = finetune_if_configured(ctx, policy, out);
+  sign_policies(o.out_dir, ensure_run_key(o.run_dir), out);  // the trained run's key
   const EvaluationResult evaluation = evaluate_stage(ctx, kept, out);
   report_stage(ctx, kept, evaluation, out);
   return 0;
