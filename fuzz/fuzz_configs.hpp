@@ -24,4 +24,15 @@ inline learner::LearnerNodeConfig small_learner_config() {
   return c;
 }
 
+/// The same in the reproducible mode: rounds from two actors, weights every 2 updates, a
+/// checkpoint-free snapshot-free node (files would slow every input down).
+inline learner::LearnerNodeConfig small_reproducible_learner_config() {
+  learner::LearnerNodeConfig c = small_learner_config();
+  c.reproducible = true;
+  c.max_actors = 2;
+  c.round_weights_every_steps = 1;
+  c.checkpoint_every_updates = 0;
+  return c;
+}
+
 }  // namespace auvrl::fuzz

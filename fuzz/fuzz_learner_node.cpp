@@ -2,7 +2,9 @@
 // on the in-process transport and handled by LearnerNode (the code auv_learner runs): batches
 // go into the replay buffer and hindsight index, updates run, weights are broadcast. Small
 // networks and buffer so that an input runs in microseconds; the paper's state layout. Sound
-// experience of other sizes stops the learner (UnrecoverableFault): the input ends there.
+// experience of other sizes stops the learner (UnrecoverableFault): the input ends there. Bit 6
+// of the first byte picks the reproducible mode (rounds collected from two actors, weights by
+// round and index, requests for a round's weights); experience of the other mode stops it too.
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/weights_request_t.hpp>
@@ -16,10 +18,11 @@
 using namespace auvrl;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const learner::LearnerNodeConfig config = fuzz::small_learner_config();
+  static const learner::LearnerNodeConfig asynchronous = fuzz::small_learner_config();
+  static const learner::LearnerNodeConfig reproducible = fuzz::small_reproducible_learner_config();
   static fuzz::NullStream log;
   transport::Transport& t = fuzz::in_process_transport();
-  learner::LearnerNode node(config, t, log);
+  learner::LearnerNode node(size > 0 && (data[0] & 0x40) ? reproducible : asynchronous, t, log);
   for (const fuzz::Record& r : fuzz::read_records(data, size)) {
     std::vector<std::uint8_t> bytes;
     std::string channel;

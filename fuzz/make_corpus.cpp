@@ -150,6 +150,28 @@ void learner_seeds(const learner::LearnerNodeConfig& config) {
   fuzz::append_record(bodies, 0x80, body(fuzz::encode(experience(sd, ad, 5, 0, 1, 3))));
   fuzz::append_record(bodies, 0x80 | 2, body(fuzz::encode(report)));
   write_seed("fuzz_learner_node", "bodies", bodies);
+
+  // The reproducible mode (bit 6 of the first byte): round 1 from actors 1 and 0 (two batches),
+  // a resend, then requests for the round's weights.
+  const auto round_batch = [&](int actor, int index, int count, int n) {
+    auvrl_lcm::experience_batch_t m = experience(sd, ad, n, actor, index + 1, 1);
+    m.round = 1;
+    m.round_batch = index;
+    m.round_batches = count;
+    m.round_episodes = 1;
+    return m;
+  };
+  auvrl_lcm::weights_request_t want = request;
+  want.want_round = 1;
+  want.want_index = 1;
+  Bytes rounds;
+  // 0x42: bit 6 for the mode, and (0x42 & 0x7F) % 3 == 0: experience.
+  fuzz::append_record(rounds, 0x42, fuzz::encode(round_batch(1, 0, 1, 6)));
+  fuzz::append_record(rounds, 0, fuzz::encode(round_batch(0, 1, 2, 4)));
+  fuzz::append_record(rounds, 0, fuzz::encode(round_batch(0, 1, 2, 4)));
+  fuzz::append_record(rounds, 0, fuzz::encode(round_batch(0, 0, 2, 5)));
+  fuzz::append_record(rounds, 1, fuzz::encode(want));
+  write_seed("fuzz_learner_node", "reproducible_round", rounds);
 }
 
 void checkpoint_seeds(learner::LearnerNodeConfig config) {

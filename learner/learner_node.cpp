@@ -75,7 +75,8 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
       throw std::invalid_argument(
           "snapshot_every_updates and checkpoint_every_updates must be >= 0");
     }
-    collector_ = std::make_unique<RoundCollector>(config_.max_actors);
+    // An episode's transitions come one or more to a batch.
+    collector_ = std::make_unique<RoundCollector>(config_.max_actors, config_.task.max_steps);
     // Round 0 has no experience: its only weights are the initial networks'.
     round_weights_.begin(0);
     round_updates_owed_ = round_updates_done_ = 0;

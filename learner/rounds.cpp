@@ -1,10 +1,13 @@
 #include "learner/rounds.hpp"
 
+#include <algorithm>
+
 #include "common/transport.hpp"
 
 namespace auvrl::learner {
 
-RoundCollector::RoundCollector(int actors) : actors_(static_cast<std::size_t>(actors)) {}
+RoundCollector::RoundCollector(int actors, int max_batches)
+    : actors_(static_cast<std::size_t>(actors)), max_batches_(std::max(1, max_batches)) {}
 
 RoundCollector::Offer RoundCollector::offer(const auvrl_lcm::experience_batch_t& msg,
                                             std::int64_t awaited) {
@@ -12,7 +15,8 @@ RoundCollector::Offer RoundCollector::offer(const auvrl_lcm::experience_batch_t&
     return Offer::kMalformed;
   }
   if (msg.round != awaited) return Offer::kOtherRound;
-  if (msg.round_batches < 1 || msg.round_batch < 0 || msg.round_batch >= msg.round_batches ||
+  if (msg.round_batches < 1 || msg.round_batches > max_batches_ || msg.round_batch < 0 ||
+      msg.round_batch >= msg.round_batches ||
       (msg.num_transitions == 0 && msg.round_batches != 1) || msg.round_episodes < 0) {
     return Offer::kMalformed;
   }

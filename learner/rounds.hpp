@@ -16,14 +16,18 @@ namespace auvrl::learner {
 /// Collects the batches of one round (the one awaited) from actors 0 .. actors - 1.
 class RoundCollector {
  public:
-  explicit RoundCollector(int actors);
+  /// max_batches bounds what a round may claim (round_batches): an episode of max_steps
+  /// transitions comes in at most that many batches.
+  RoundCollector(int actors, int max_batches);
 
   /// What offer() did with a batch.
   enum class Offer {
     kStored,      ///< kept for the awaited round
     kDuplicate,   ///< that batch of that actor's round is already held (a resend)
     kOtherRound,  ///< of a round already taken, or not yet awaited: dropped
-    kMalformed,   ///< round_batch or round_batches out of range, or not as the actor said before
+    /// round_batch or round_batches out of range (more than max_batches), or not as the actor
+    /// said before
+    kMalformed,
   };
   /// Offers a batch (already checked for sizes and values) of msg.round; `awaited` is the round
   /// the learner takes next.
@@ -44,6 +48,7 @@ class RoundCollector {
     int held = 0;
   };
   std::vector<ActorRound> actors_;
+  int max_batches_;
 };
 
 /// One of the weights the learner published for its current round.

@@ -51,7 +51,7 @@ TEST(RoundSchedule, CountsStepsAndUpdates) {
 }
 
 TEST(RoundCollector, CompleteOnlyWithEveryBatchOfEveryActorAndInActorOrder) {
-  RoundCollector c(2);
+  RoundCollector c(2, 10);
   EXPECT_EQ(c.offer(round_batch(1, 3, 1, 2), 3), RoundCollector::Offer::kStored);
   EXPECT_EQ(c.offer(round_batch(0, 3, 0, 1), 3), RoundCollector::Offer::kStored);
   EXPECT_FALSE(c.complete());
@@ -74,10 +74,18 @@ TEST(RoundCollector, CompleteOnlyWithEveryBatchOfEveryActorAndInActorOrder) {
 }
 
 TEST(RoundCollector, AnEmptyBatchClosesARoundOnlyAsItsOnlyBatch) {
-  RoundCollector c(1);
+  RoundCollector c(1, 10);
   EXPECT_EQ(c.offer(round_batch(0, 1, 0, 2, 0), 1), RoundCollector::Offer::kMalformed);
   EXPECT_EQ(c.offer(round_batch(0, 1, 0, 1, 0), 1), RoundCollector::Offer::kStored);
   EXPECT_TRUE(c.complete());
+}
+
+TEST(RoundCollector, ARoundClaimingMoreBatchesThanAnEpisodeHasIsRefused) {
+  // (A fuzz finding: round_batches of 2^30 made the collector reserve for them.)
+  RoundCollector c(1, 700);
+  EXPECT_EQ(c.offer(round_batch(0, 1, 0, 1 << 30), 1), RoundCollector::Offer::kMalformed);
+  EXPECT_EQ(c.offer(round_batch(0, 1, 0, 701), 1), RoundCollector::Offer::kMalformed);
+  EXPECT_EQ(c.offer(round_batch(0, 1, 0, 700), 1), RoundCollector::Offer::kStored);
 }
 
 TEST(RoundWeightsHistory, CheckpointRecordRoundTrips) {
