@@ -1,9 +1,7 @@
 #include "launcher/best_policy.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
-#include <limits>
 #include <optional>
 
 #include "common/nn/file_io.hpp"
@@ -47,43 +45,6 @@ void BestPolicyKeeper::consider(const nn::Mlp& net, std::int64_t version, double
 bool BestPolicyKeeper::best_ranks_above(const std::string& path) const {
   const nn::Mlp last = nn::network_from_bytes(nn::read_file(path), 1);
   return eval::ranks_above(best_, quick_.evaluate(last), {max_hold_m_, true});
-}
-
-namespace {
-
-/// The update count in a snapshot's file name policy-<digits>.nn; -1 for any other name.
-std::int64_t snapshot_updates(const std::string& name) {
-  const std::string prefix = "policy-", suffix = ".nn";
-  if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0 ||
-      name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
-    return -1;
-  }
-  const std::string digits =
-      name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
-  constexpr std::size_t kMaxDigits = std::numeric_limits<std::int64_t>::digits10;
-  if (digits.size() > kMaxDigits ||
-      !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) {
-    return -1;
-  }
-  return std::stoll(digits);
-}
-
-}  // namespace
-
-std::vector<PolicySnapshot> list_snapshots(const std::string& dir) {
-  std::vector<PolicySnapshot> snapshots;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::int64_t updates = snapshot_updates(entry.path().filename().string());
-    if (updates >= 0 && entry.is_regular_file(ec)) {
-      snapshots.push_back({updates, entry.path().string()});
-    }
-  }
-  std::sort(snapshots.begin(), snapshots.end(),
-            [](const PolicySnapshot& a, const PolicySnapshot& b) {
-              return a.updates != b.updates ? a.updates < b.updates : a.path < b.path;
-            });
-  return snapshots;
 }
 
 void SnapshotReviewer::remove(const PolicySnapshot& snapshot, std::ostream& out) {

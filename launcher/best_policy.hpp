@@ -15,6 +15,7 @@
 #include "eval/evaluation.hpp"
 #include "eval/quick_evaluator.hpp"
 #include "launcher/telemetry.hpp"
+#include "learner/checkpoint.hpp"
 
 namespace auvrl::launcher {
 
@@ -54,15 +55,9 @@ class BestPolicyKeeper {
   std::int64_t best_version_ = -1;
 };
 
-/// One actor network the learner wrote in reproducible mode (auv_learner --snapshot-dir).
-struct PolicySnapshot {
-  std::int64_t updates = 0;  ///< the learner's update count when it wrote it
-  std::string path;          ///< <dir>/policy-<updates, 12 digits>.nn
-};
-
-/// The snapshots in dir in increasing update order: the files named policy-<digits>.nn. The
-/// learner's temporary files and anything else are left out; a missing dir holds none.
-std::vector<PolicySnapshot> list_snapshots(const std::string& dir);
+// The learner's snapshots: named and listed where the learner writes them.
+using learner::list_snapshots;
+using learner::PolicySnapshot;
 
 /// Hands the learner's snapshots in dir to a BestPolicyKeeper, each once and in update order,
 /// and deletes each file once considered, so that the best policy of a reproducible run does

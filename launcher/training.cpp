@@ -348,14 +348,8 @@ void TrainingSession::start_processes() {
 
 void TrainingSession::announce_mode() {
   const RunConfig& rc = ctx_.rc;
-  if (!rc.run.reproducible) {
-    if (ctx_.options.resume && fs::exists(snapshot_dir(ctx_.run_dir))) {
-      out_ << "auvrl train: note: " << ctx_.run_dir
-           << " was trained with --reproducible (it has snapshots/); without it this "
-              "invocation trains asynchronously (give --reproducible to continue reproducibly)\n";
-    }
-    return;
-  }
+  // (A resumed run keeps its mode: prepare_run_directory restores its command line.)
+  if (!rc.run.reproducible) return;
   fs::create_directories(snapshot_dir(ctx_.run_dir));
   std::string budget;
   if (rc.learner_max_updates > 0) budget = fmt::format("{} updates", rc.learner_max_updates);

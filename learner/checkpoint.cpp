@@ -1,6 +1,8 @@
 #include "learner/checkpoint.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -14,32 +16,66 @@ namespace auvrl::learner {
 namespace fs = std::filesystem;
 
 namespace {
+
 constexpr const char* kPrefix = "checkpoint-";
 constexpr const char* kSuffix = ".ckpt";
-}  // namespace
+constexpr const char* kSnapshotPrefix = "policy-";
+constexpr const char* kSnapshotSuffix = ".nn";
 
-std::vector<CheckpointFile> list_checkpoints(const std::string& dir) {
-  std::vector<CheckpointFile> found;
+/// The learner's files numbered by update count: <prefix><updates, 12 digits><suffix>.
+std::string numbered_name(const char* prefix, std::int64_t updates, const char* suffix) {
+  char name[64];
+  std::snprintf(name, sizeof name, "%s%012lld%s", prefix, static_cast<long long>(updates), suffix);
+  return name;
+}
+
+/// The regular files of dir named <prefix><digits><suffix>, with their numbers, in increasing
+/// order (a missing dir holds none).
+std::vector<std::pair<std::int64_t, std::string>> numbered_files(const std::string& dir,
+                                                                 const std::string& prefix,
+                                                                 const std::string& suffix) {
+  std::vector<std::pair<std::int64_t, std::string>> found;
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return found;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
-    const std::string prefix = kPrefix, suffix = kSuffix;
     if (name.size() <= prefix.size() + suffix.size() || name.rfind(prefix, 0) != 0 ||
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0) {
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) != 0 ||
+        !entry.is_regular_file(ec)) {
       continue;
     }
     const std::string digits =
         name.substr(prefix.size(), name.size() - prefix.size() - suffix.size());
-    if (digits.empty() || !std::all_of(digits.begin(), digits.end(), ::isdigit) ||
-        digits.size() > 18) {
+    if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(),
+                                           [](unsigned char c) { return std::isdigit(c); })) {
       continue;
     }
-    found.push_back({entry.path().string(), std::stoll(digits)});
+    found.emplace_back(std::stoll(digits), entry.path().string());
   }
-  std::sort(found.begin(), found.end(),
-            [](const CheckpointFile& a, const CheckpointFile& b) { return a.updates > b.updates; });
+  std::sort(found.begin(), found.end());
   return found;
+}
+
+}  // namespace
+
+std::vector<CheckpointFile> list_checkpoints(const std::string& dir) {
+  std::vector<CheckpointFile> newest_first;
+  const auto found = numbered_files(dir, kPrefix, kSuffix);
+  for (auto it = found.rbegin(); it != found.rend(); ++it) {
+    newest_first.push_back({it->second, it->first});
+  }
+  return newest_first;
+}
+
+std::string snapshot_path(const std::string& dir, std::int64_t updates) {
+  return (fs::path(dir) / numbered_name(kSnapshotPrefix, updates, kSnapshotSuffix)).string();
+}
+
+std::vector<PolicySnapshot> list_snapshots(const std::string& dir) {
+  std::vector<PolicySnapshot> oldest_first;
+  for (auto& [updates, path] : numbered_files(dir, kSnapshotPrefix, kSnapshotSuffix)) {
+    oldest_first.push_back({updates, std::move(path)});
+  }
+  return oldest_first;
 }
 
 std::string write_checkpoint(const std::string& dir, std::int64_t updates, int keep,
@@ -48,10 +84,7 @@ std::string write_checkpoint(const std::string& dir, std::int64_t updates, int k
   fs::create_directories(dir, ec);
   if (ec)
     throw std::runtime_error("cannot create checkpoint directory " + dir + ": " + ec.message());
-  char name[64];
-  std::snprintf(name, sizeof name, "%s%012lld%s", kPrefix, static_cast<long long>(updates),
-                kSuffix);
-  const std::string path = (fs::path(dir) / name).string();
+  const std::string path = (fs::path(dir) / numbered_name(kPrefix, updates, kSuffix)).string();
   nn::write_file_atomically(path, [&](nn::ByteSink& sink) {
     nn::Writer writer(sink);
     fill(writer);

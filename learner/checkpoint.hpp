@@ -22,6 +22,21 @@ struct CheckpointFile {
 /// Checkpoints in dir, newest (most updates) first. A missing directory gives none.
 std::vector<CheckpointFile> list_checkpoints(const std::string& dir);
 
+/// A snapshot of the actor network the learner writes in the reproducible mode (the launcher
+/// gives each the quick evaluation for the best policy): <dir>/policy-<updates>.nn.
+struct PolicySnapshot {
+  std::int64_t updates = 0;  ///< the learner's update count when it wrote it
+  std::string path;          ///< <dir>/policy-<updates, 12 digits>.nn
+};
+
+/// Where the snapshot at `updates` goes in dir.
+std::string snapshot_path(const std::string& dir, std::int64_t updates);
+
+/// The snapshots in dir, oldest (fewest updates) first: the regular files named
+/// policy-<digits>.nn (the learner's temporary files and anything else are left out). A
+/// missing directory gives none.
+std::vector<PolicySnapshot> list_snapshots(const std::string& dir);
+
 /// Writes dir/checkpoint-<updates>.ckpt atomically with `fill`, then deletes all but the
 /// newest `keep` checkpoints. Returns the path. Throws std::runtime_error naming the path if
 /// the file cannot be written (disk full, no permission): the older checkpoints are intact.

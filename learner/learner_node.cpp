@@ -309,8 +309,7 @@ void LearnerNode::after_update() {
 }
 
 void LearnerNode::write_snapshot() {
-  const std::string path =
-      fmt::format("{}/policy-{:012d}.nn", config_.snapshot_dir, ddpg_->updates());
+  const std::string path = snapshot_path(config_.snapshot_dir, ddpg_->updates());
   try {
     std::filesystem::create_directories(config_.snapshot_dir);
     nn::save_network_file(path, ddpg_->actor());

@@ -14,12 +14,12 @@
 #include "child_process.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/nn/serialize.hpp"
-#include "find_role.hpp"
 #include "launcher/best_policy.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/run_config.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/training.hpp"
+#include "roles_fixture.hpp"
 #include "run_files.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -170,26 +170,15 @@ TEST_F(ReproducibleRunTest, TheInnerCommandPassesTheModeAndTheBudgetOn) {
   EXPECT_TRUE(has(command, {"--max-updates", "0"}));
 }
 
-class ReproducibleRolesTest : public ::testing::Test {
+class ReproducibleRolesTest : public test_support::RolesFixture {
  protected:
   void SetUp() override {
-    ctx.options.bin_dir = "/bin";
-    ctx.run_dir = test_support::make_temp_dir("auvrl_repro_roles_");
-    fs::create_directories(fs::path(ctx.run_dir) / "checkpoints");
-    ctx.config_path = ctx.run_dir + "/config.yaml";
-    ctx.rc.vehicle_path = "/v.yaml";
-    ctx.rc.run.seed = 3;
+    RolesFixture::SetUp();
     ctx.rc.run.reproducible = true;
     ctx.rc.run.round_weights_every_steps = 50;
     ctx.rc.run.best_eval_every_updates = 1000;
     ctx.rc.learner_max_updates = 9000;
-    ctx.cpus = 4;
-    ctx.actors = 2;
   }
-  static const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
-    return test_support::find_role(roles, name);
-  }
-  RunContext ctx;
 };
 
 TEST_F(ReproducibleRolesTest, TheLearnerGetsTheModeTheSnapshotsAndTheOverride) {

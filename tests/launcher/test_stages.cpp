@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "child_process.hpp"
-#include "find_role.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/refinetune.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/training.hpp"
+#include "roles_fixture.hpp"
 
 namespace auvrl::launcher {
 namespace {
@@ -119,23 +119,7 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   EXPECT_THROW(refinetune(o, again), std::invalid_argument);
 }
 
-class RolesTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    ctx.options.bin_dir = "/bin";
-    ctx.run_dir = test_support::make_temp_dir("auvrl_roles_");
-    fs::create_directories(fs::path(ctx.run_dir) / "checkpoints");
-    ctx.config_path = ctx.run_dir + "/config.yaml";
-    ctx.rc.vehicle_path = "/v.yaml";
-    ctx.rc.run.seed = 3;
-    ctx.cpus = 4;
-    ctx.actors = 2;
-  }
-  static const RoleSpec& find(const std::vector<RoleSpec>& roles, const std::string& name) {
-    return test_support::find_role(roles, name);
-  }
-  RunContext ctx;
-};
+using RolesTest = test_support::RolesFixture;
 
 TEST_F(RolesTest, StartOrderKindsAndLogs) {
   const auto roles = make_roles(ctx, {"--transport", "lcm"});
