@@ -96,7 +96,7 @@ ActorNode::ActorNode(ActorNodeConfig config, transport::Transport& transport, st
           weights_queue_.push_back(m);
         },
         nullptr, 256);
-    round_progress_ = round_request_ = Clock::now();
+    round_progress_ = last_request_ = Clock::now();
   } else {
     weights_ = std::make_unique<transport::Latest<auvrl_lcm::policy_weights_t>>(
         transport_, channels::kPolicyWeights, 8);
@@ -136,15 +136,20 @@ void ActorNode::refresh_policy() {
   const double since_request = std::chrono::duration<double>(now - last_request_).count();
   const bool want = policy_.policy() == nullptr || silence > config_.weights_silence_s;
   if (want && since_request >= config_.weights_request_period_s) {
-    auvrl_lcm::weights_request_t req{};
-    req.utime = transport::now_utime();
-    req.actor_id = config_.actor_id;
-    req.have_version = policy_.version();
-    req.want_round = -1;
-    transport::publish(transport_, channels::kWeightsRequest, req);
-    last_request_ = now;
-    ++counters_.weights_requests;
+    send_weights_request(-1, 0);
   }
+}
+
+void ActorNode::send_weights_request(std::int64_t want_round, std::int32_t want_index) {
+  auvrl_lcm::weights_request_t req{};
+  req.utime = transport::now_utime();
+  req.actor_id = config_.actor_id;
+  req.have_version = policy_.version();
+  req.want_round = want_round;
+  req.want_index = want_index;
+  transport::publish(transport_, channels::kWeightsRequest, req);
+  last_request_ = Clock::now();
+  ++counters_.weights_requests;
 }
 
 void ActorNode::wait_for_learner() {

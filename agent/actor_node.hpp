@@ -137,6 +137,8 @@ class ActorNode {
 
   /// Applies the newest weights that have arrived (drained, newest kept); asks when due.
   void refresh_policy();
+  /// WEIGHTS_REQUEST for round want_round's index want_index (-1: the newest weights).
+  void send_weights_request(std::int64_t want_round, std::int32_t want_index);
   /// Draws the episode's way-point, start and conditions, runs it (transitions kept) and counts
   /// it; goal receives the way-point.
   EpisodeSummary play_episode(std::vector<Transition>& transitions, Eigen::Vector3d& goal);
@@ -194,7 +196,6 @@ class ActorNode {
   std::int64_t sent_round_ = kNoRound;
   std::vector<auvrl_lcm::experience_batch_t> sent_;  ///< kept until the learner takes it
   std::chrono::steady_clock::time_point round_progress_;
-  std::chrono::steady_clock::time_point round_request_;
   std::chrono::steady_clock::time_point waiting_since_;  ///< for weights mid-round
   std::deque<auvrl_lcm::policy_weights_t> weights_queue_;
   transport::SubscriptionId weights_subscription_ = -1;

@@ -1,6 +1,5 @@
 // ActorNode's reproducible mode (common/round_schedule.hpp): rounds numbered by the learner,
 // weights by round and index, random streams drawn from the seed and the round.
-#include <auvrl_lcm/weights_request_t.hpp>
 #include <random>
 
 #include "agent/actor_node.hpp"
@@ -73,16 +72,8 @@ void ActorNode::pump_weights() {
 }
 
 void ActorNode::request_round_weights(std::int64_t round, std::int32_t index) {
-  if (seconds_since(round_request_) < config_.round_request_s) return;
-  auvrl_lcm::weights_request_t req{};
-  req.utime = transport::now_utime();
-  req.actor_id = config_.actor_id;
-  req.have_version = policy_.version();
-  req.want_round = round;
-  req.want_index = index;
-  transport::publish(transport_, channels::kWeightsRequest, req);
-  round_request_ = Clock::now();
-  ++counters_.weights_requests;
+  if (seconds_since(last_request_) < config_.round_request_s) return;
+  send_weights_request(round, index);
 }
 
 bool ActorNode::await_round_start() {
