@@ -2,10 +2,13 @@
 
 #include <sched.h>
 
+#include <algorithm>
+#include <chrono>
 #include <memory>
 #include <stdexcept>
 
 #include "agent/pid_controller.hpp"
+#include "common/channels.hpp"
 #include "common/signals.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -78,6 +81,36 @@ void run_actor_episodes(ActorNode& node, const ActorNodeConfig& config, int repo
   log << "\n";
 }
 
+namespace {
+
+/// Waits for the readers options.wait_for_readers names (see ActorProcessOptions).
+void wait_for_system(transport::Transport& transport, const ActorProcessOptions& options,
+                     int actor_id, std::ostream& log) {
+  if (options.wait_for_readers.empty()) return;
+  const auto timeout = std::chrono::milliseconds(static_cast<int>(options.wait_for_readers_s * 1e3));
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<std::string> missing =
+      transport.wait_for_readers(channels::kExperience, options.wait_for_readers, timeout);
+  const bool wants_learner = std::find(options.wait_for_readers.begin(),
+                                       options.wait_for_readers.end(),
+                                       "learner") != options.wait_for_readers.end();
+  if (missing.empty() && wants_learner) {
+    const auto left = timeout - (std::chrono::steady_clock::now() - start);
+    missing = transport.wait_for_readers(
+        channels::kWeightsRequest, {"learner"},
+        std::max(std::chrono::milliseconds(0),
+                 std::chrono::duration_cast<std::chrono::milliseconds>(left)));
+  }
+  if (!missing.empty()) {
+    std::string names;
+    for (const std::string& m : missing) names += (names.empty() ? "" : ", ") + m;
+    log << "auv_actor " << actor_id << ": no reader of role " << names << " found in "
+        << options.wait_for_readers_s << " s; starting anyway\n";
+  }
+}
+
+}  // namespace
+
 void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions& options,
                        const transport::TransportConfig& transport_config,
                        const transport::LockstepBusOptions& lockstep_bus, std::ostream& log) {
@@ -86,6 +119,7 @@ void run_actor_process(const ActorNodeConfig& config, const ActorProcessOptions&
   std::unique_ptr<transport::Transport> lockstep;
   if (lockstep_config) lockstep = transport::make_transport(*lockstep_config);
   signals::install_stop_handlers();
+  wait_for_system(*transport, options, config.actor_id, log);
   ActorNode node(config, *transport, log, lockstep.get());
   log << "auv_actor " << config.actor_id << ": vehicle " << config.vehicle_id << " "
       << describe(config.vehicle) << ", " << task::to_string(config.task.layout) << " state ("

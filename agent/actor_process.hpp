@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "agent/actor_node.hpp"
 #include "common/transport_options.hpp"
@@ -18,6 +19,11 @@ struct ActorProcessOptions {
   int report_every = 50;     ///< a log line every N policy episodes
   std::int64_t seed = 1;     ///< way-points and noise
   std::string vehicle_path;  ///< the vehicle file ("": default_vehicle_file())
+  /// Before its first episode, wait for readers of these roles (learner, logger) on its
+  /// experience and episode channels (and for the learner on its weights requests), so that
+  /// the first messages are not lost to readers not yet discovered (Transport::wait_for_readers).
+  std::vector<std::string> wait_for_readers;
+  double wait_for_readers_s = 30;  ///< at most this long; then it starts anyway, saying so
 };
 
 /// Completes `config` from `options` (vehicle id, seed, the vehicle file's facts into the task),

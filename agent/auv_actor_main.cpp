@@ -43,9 +43,17 @@ int main(int argc, char** argv) {
   cmd.option("pin-cpu", &options.pin_cpu, "pin this process to one CPU (-1: no)");
   cmd.option("report-every", &options.report_every, "a log line every N episodes");
   add_reproducible_options(cmd, &config.reproducible, &config.round_weights_every_steps);
+  cmd.custom_option(
+      "wait-for-readers",
+      [&options](const std::string& v) { options.wait_for_readers = transport::parse_comma_list(v, "role"); },
+      "", "before the first episode, wait for readers of these roles (learner,logger; DDS "
+      "discovery), so that no first message is lost", "list");
+  cmd.option("wait-for-readers-s", &options.wait_for_readers_s,
+             "wait at most this long for them, then start anyway");
   cmd.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the run file's vehicle:, else config/vehicles/nessie7.yaml)");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "actor";
   transport::add_lockstep_options(cmd, lockstep_bus);
   try {
     if (!cmd.parse(argc, argv)) return 0;

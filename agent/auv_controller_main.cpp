@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
            "exit once the mission is complete (after --linger-s) or aborted");
   cmd.option("linger-s", &options.linger_s, "vehicle seconds to hold the last way-point first");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "controller";
   agent::ControllerSetup setup;
   try {
     if (!cmd.parse(argc, argv)) return 0;

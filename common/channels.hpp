@@ -1,6 +1,7 @@
 // Channel names of the system, in one place, so every process and tool agrees on them.
 #pragma once
 
+#include <iterator>
 #include <string>
 
 namespace auvrl::channels {
@@ -47,7 +48,7 @@ inline const std::string kSimCurrentPattern = "SIM_CURRENT_[0-9]+";
 
 /// How a transport that distinguishes kinds of traffic (Cyclone DDS; LCM treats every channel
 /// alike) must carry a channel. Which class a channel belongs to is decided here, by the
-/// prefixes of kChannelClassPrefixes, and nowhere else.
+/// families of kChannelFamilies, and nowhere else.
 enum class ChannelClass {
   /// Self-superseding state (policy weights and their summary): only the newest matters, and a
   /// late joiner must get it at once without asking (reliable, keep-last-1, transient-local).
@@ -63,31 +64,58 @@ enum class ChannelClass {
   kOther,
 };
 
-/// A channel name prefix and the class of the channels that begin with it.
-struct ChannelClassPrefix {
-  const char* prefix;
+/// A DDS topic of the system. Each carries the channels of one kind of publisher, so that
+/// DDS Security can grant publishing and subscribing per role (common/dds_security.hpp), and
+/// has the QoS of its channel class.
+struct DdsTopic {
+  const char* name;
   ChannelClass channel_class;
 };
 
-/// The channel classes, by prefix (first match wins; no match: kOther).
-inline constexpr ChannelClassPrefix kChannelClassPrefixes[] = {
-    {"POLICY_", ChannelClass::kState},          // POLICY_WEIGHTS, POLICY_SUMMARY
-    {"EXPERIENCE", ChannelClass::kQueue},       //
-    {"EPISODE", ChannelClass::kQueue},          //
-    {"WEIGHTS_REQUEST", ChannelClass::kQueue},  //
-    {"SIM_CMD_", ChannelClass::kLockstep},      //
-    {"SIM_STATE_", ChannelClass::kLockstep},    //
-    {"SIM_RESET_", ChannelClass::kLockstep},    //
-    {"SIM_FAULT_", ChannelClass::kLockstep},    //
-    {"SIM_CURRENT_", ChannelClass::kLockstep},
+/// The topics (index = the topic's number; the last one takes every channel of no family).
+inline constexpr DdsTopic kDdsTopics[] = {
+    {"auvrl_weights", ChannelClass::kState},         // 0: POLICY_WEIGHTS, POLICY_SUMMARY
+    {"auvrl_experience", ChannelClass::kQueue},      // 1: EXPERIENCE, EPISODE
+    {"auvrl_weights_request", ChannelClass::kQueue}, // 2: WEIGHTS_REQUEST
+    {"auvrl_sim_command", ChannelClass::kLockstep},  // 3: SIM_CMD_
+    {"auvrl_sim_reset", ChannelClass::kLockstep},    // 4: SIM_RESET_
+    {"auvrl_sim_state", ChannelClass::kLockstep},    // 5: SIM_STATE_
+    {"auvrl_sim_event", ChannelClass::kLockstep},    // 6: SIM_FAULT_, SIM_CURRENT_
+    {"auvrl_learner_stats", ChannelClass::kOther},   // 7: LEARNER_STATS
+    {"auvrl_heartbeat", ChannelClass::kOther},       // 8: SIM_HEARTBEAT, LOGGER_HEARTBEAT
+    {"auvrl_mission", ChannelClass::kOther},         // 9: MISSION_
+    {"auvrl_mission_status", ChannelClass::kOther},  // 10: MISSION_STATUS
+    {"auvrl_other", ChannelClass::kOther},           // 11: anything else
+};
+inline constexpr int kDdsTopicCount = static_cast<int>(std::size(kDdsTopics));
+/// The topic of channels of no family.
+inline constexpr int kOtherDdsTopic = kDdsTopicCount - 1;
+
+/// A channel name prefix and the topic (and so the class) of the channels that begin with it.
+struct ChannelFamily {
+  const char* prefix;
+  int dds_topic;  ///< index into kDdsTopics
 };
 
-/// The class of a channel (see kChannelClassPrefixes).
-inline ChannelClass channel_class(const std::string& channel) {
-  for (const ChannelClassPrefix& p : kChannelClassPrefixes) {
-    if (channel.rfind(p.prefix, 0) == 0) return p.channel_class;
+/// The channel families, by prefix (first match wins; no match: kOtherDdsTopic).
+inline constexpr ChannelFamily kChannelFamilies[] = {
+    {"POLICY_", 0},  {"EXPERIENCE", 1},    {"EPISODE", 1},        {"WEIGHTS_REQUEST", 2},
+    {"SIM_CMD_", 3}, {"SIM_RESET_", 4},    {"SIM_STATE_", 5},     {"SIM_FAULT_", 6},
+    {"SIM_CURRENT_", 6}, {"LEARNER_STATS", 7}, {"SIM_HEARTBEAT", 8}, {"LOGGER_HEARTBEAT", 8},
+    {"MISSION_STATUS", 10}, {"MISSION_", 9},
+};
+
+/// The DDS topic of a channel (see kChannelFamilies).
+inline int dds_topic_of(const std::string& channel) {
+  for (const ChannelFamily& f : kChannelFamilies) {
+    if (channel.rfind(f.prefix, 0) == 0) return f.dds_topic;
   }
-  return ChannelClass::kOther;
+  return kOtherDdsTopic;
+}
+
+/// The class of a channel (that of its topic).
+inline ChannelClass channel_class(const std::string& channel) {
+  return kDdsTopics[dds_topic_of(channel)].channel_class;
 }
 
 /// The vehicle id at the end of a per-vehicle channel name, or -1 if there is none.

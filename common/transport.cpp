@@ -178,4 +178,10 @@ std::int64_t now_utime() {
       .count();
 }
 
+std::vector<std::string> Transport::wait_for_readers(const std::string&,
+                                                     const std::vector<std::string>&,
+                                                     std::chrono::milliseconds) {
+  return {};
+}
+
 }  // namespace auvrl::transport

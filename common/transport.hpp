@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <chrono>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,6 +51,17 @@ struct DdsSettings {
   /// client resends a command whose answer is missing, so best effort is safe too; the
   /// docs/results.md compares the two (bench_lockstep).
   bool lockstep_reliable = true;
+  /// DDS Security: a directory made by scripts/pki.sh, or one participant's directory in it
+  /// ("" = no security). Authentication, access control and encryption in every domain the
+  /// process opens; peers off this host are then accepted without allow_off_host.
+  std::string security_dir;
+  /// The participant's name in security_dir when that is scripts/pki.sh's whole directory
+  /// ("learner", "actor-0", ...).
+  std::string security_identity;
+  /// What this process is (learner, actor, simulator, logger, ...): carried by its readers, so
+  /// that a publisher can wait for the readers of a role (Transport::wait_for_readers). Each
+  /// program sets its own.
+  std::string role;
 };
 
 /// Which transport to open and how.
@@ -107,6 +119,16 @@ class Transport {
   /// LCM's wait early (returning false); DDS waits out the timeout, so keep it short (<= 100 ms)
   /// where a stop request must be seen promptly.
   virtual bool handle_one(int timeout_ms) = 0;
+
+  /// Waits until the publisher of `channel` has found, for each role of `roles`, a reader of
+  /// that role that may receive it, or until timeout. Returns the roles still missing. Over DDS
+  /// a message published before a remote reader is discovered never reaches it (volatile
+  /// durability), so a process whose first messages matter (an actor's first episode) waits
+  /// first; each DDS reader carries its participant's role (DdsSettings::role). LCM has no
+  /// discovery: nothing to wait for (the default).
+  virtual std::vector<std::string> wait_for_readers(const std::string& channel,
+                                                    const std::vector<std::string>& roles,
+                                                    std::chrono::milliseconds timeout);
 
   /// Dispatches everything already pending, without waiting. Returns how many.
   int drain();

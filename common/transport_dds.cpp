@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <mutex>
 
 #include "auvrl_message.h"
+#include "common/dds_security.hpp"
 
 namespace auvrl::transport {
 
@@ -18,8 +20,7 @@ namespace {
 
 using channels::ChannelClass;
 
-constexpr std::array<ChannelClass, 4> kAllClasses = {ChannelClass::kState, ChannelClass::kQueue,
-                                                     ChannelClass::kLockstep, ChannelClass::kOther};
+constexpr int kTopics = channels::kDdsTopicCount;
 
 /// Depth of the writers' keep-last histories (what a reliable writer can resend).
 constexpr int kLockstepWriterDepth = 8;
@@ -131,7 +132,9 @@ void set_qos(const Qos& q, ChannelClass c, bool lockstep_reliable, int reader_ca
 class DdsTransport final : public Transport {
  public:
   DdsTransport(const DdsSettings& settings, const std::string& config)
-      : domain_id_(settings.domain_id), lockstep_reliable_(settings.lockstep_reliable) {
+      : domain_id_(settings.domain_id),
+        lockstep_reliable_(settings.lockstep_reliable),
+        reader_tag_(kRoleTag + settings.role) {
     acquire_domain(domain_id_, config);
     participant_ =
         dds_create_participant(static_cast<dds_domainid_t>(domain_id_), nullptr, nullptr);
@@ -142,14 +145,18 @@ class DdsTransport final : public Transport {
     }
     try {
       waitset_ = check(dds_create_waitset(participant_), "create a waitset");
-      // Writers of every class from the start: discovery then matches them with the readers
-      // long before the first publish, so no first message goes to nobody.
-      for (ChannelClass c : kAllClasses) {
-        const dds_entity_t topic = create_topic(c);
+      // Writers of every topic from the start: discovery then matches them with the readers
+      // long before the first publish, so no first message goes to nobody. Under DDS Security
+      // only the topics this participant's permissions let it publish get one.
+      for (int t = 0; t < kTopics; ++t) {
+        const dds_entity_t topic = create_topic(t);
+        if (topic == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) continue;
         Qos qos;
-        set_qos(qos, c, lockstep_reliable_, -1);
-        writers_[index(c)] =
-            check(dds_create_writer(participant_, topic, qos.get(), nullptr), "create a writer");
+        set_qos(qos, channels::kDdsTopics[t].channel_class, lockstep_reliable_, -1);
+        const dds_entity_t writer = dds_create_writer(participant_, check(topic, "create a topic"),
+                                                      qos.get(), nullptr);
+        if (writer == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) continue;
+        writers_[t] = check(writer, "create a writer");
       }
     } catch (...) {
       dds_delete(participant_);
@@ -164,9 +171,10 @@ class DdsTransport final : public Transport {
     // newest weights. Give them a bounded time to arrive (a dead reader that is still matched
     // holds this up at most that long).
     const dds_time_t deadline = dds_time() + to_dds(kAckWaitOnClose);
-    for (ChannelClass c : {ChannelClass::kQueue, ChannelClass::kState}) {
-      if (written_[index(c)] > 0) {
-        dds_wait_for_acks(writers_[index(c)], std::max<dds_duration_t>(0, deadline - dds_time()));
+    for (int t = 0; t < kTopics; ++t) {
+      const ChannelClass c = channels::kDdsTopics[t].channel_class;
+      if ((c == ChannelClass::kQueue || c == ChannelClass::kState) && written_[t] > 0) {
+        dds_wait_for_acks(writers_[t], std::max<dds_duration_t>(0, deadline - dds_time()));
       }
     }
     dds_delete(participant_);  // and every reader, writer, topic and the waitset in it
@@ -185,9 +193,15 @@ class DdsTransport final : public Transport {
     msg.data._length = static_cast<std::uint32_t>(size);
     msg.data._maximum = static_cast<std::uint32_t>(size);
     msg.data._release = false;
-    const ChannelClass channel_class = channels::channel_class(channel);
-    const dds_return_t rc = dds_write(writers_[index(channel_class)], &msg);
-    ++written_[index(channel_class)];
+    const int t = channels::dds_topic_of(channel);
+    if (writers_[t] == 0) {
+      throw TransportError("DDS publish refused on channel " + channel +
+                           ": this participant's DDS Security permissions do not allow "
+                           "publishing on topic " +
+                           channels::kDdsTopics[t].name);
+    }
+    const dds_return_t rc = dds_write(writers_[t], &msg);
+    ++written_[t];
     if (rc == DDS_RETCODE_TIMEOUT) {
       throw TransportError("DDS publish on channel " + channel + " (" + std::to_string(size) +
                            " bytes) timed out: a reader does not keep up (back-pressure)");
@@ -209,24 +223,43 @@ class DdsTransport final : public Transport {
     }
     sub->regex_ok = true;
     const SubscriptionId id = next_id_++;
+    std::vector<std::string> denied;
     try {
-      for (ChannelClass c : classes_possibly_matching(channel_regex)) {
+      for (int t : topics_possibly_matching(channel_regex)) {
         // A topic entity of its own, so that the filter (this subscription's regex) applies
         // to this reader only.
-        const dds_entity_t topic = create_topic(c);
+        const dds_entity_t topic = create_topic(t);
+        if (topic == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) {
+          denied.push_back(channels::kDdsTopics[t].name);
+          continue;
+        }
+        sub->entities.push_back(check(topic, "create a topic"));
         check(dds_set_topic_filter_and_arg(topic, &Subscription::accept, sub.get()),
               "set a topic filter");
         Qos qos;
-        set_qos(qos, c, lockstep_reliable_, std::max(1, queue_capacity));
-        const dds_entity_t reader =
-            check(dds_create_reader(participant_, topic, qos.get(), nullptr), "create a reader");
-        sub->entities.push_back(reader);
-        sub->entities.push_back(topic);
+        set_qos(qos, channels::kDdsTopics[t].channel_class, lockstep_reliable_,
+                std::max(1, queue_capacity));
+        dds_qset_userdata(qos.get(), reader_tag_.data(), reader_tag_.size());
+        const dds_entity_t reader = dds_create_reader(participant_, topic, qos.get(), nullptr);
+        if (reader == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) {
+          denied.push_back(channels::kDdsTopics[t].name);
+          continue;
+        }
+        sub->entities.push_back(check(reader, "create a reader"));
         const dds_entity_t condition =
             check(dds_create_readcondition(reader, DDS_ANY_STATE), "create a read condition");
         check(dds_waitset_attach(waitset_, condition, static_cast<dds_attach_t>(reader)),
               "attach a read condition");
         sub->readers.push_back(reader);
+      }
+      // A regex over several topics reads those it may; one that may read none is refused.
+      if (sub->readers.empty() && !denied.empty()) {
+        std::string names;
+        for (const std::string& n : denied) names += (names.empty() ? "" : ", ") + n;
+        throw TransportError("DDS cannot subscribe to '" + channel_regex +
+                             "': this participant's DDS Security permissions do not allow "
+                             "subscribing to topic " +
+                             names);
       }
     } catch (...) {
       for (dds_entity_t e : sub->entities) dds_delete(e);
@@ -235,6 +268,26 @@ class DdsTransport final : public Transport {
     subscriptions_.emplace(id, std::move(sub));
     rebuild_reader_list();
     return id;
+  }
+
+  std::vector<std::string> wait_for_readers(const std::string& channel,
+                                            const std::vector<std::string>& roles,
+                                            std::chrono::milliseconds timeout) override {
+    const dds_entity_t writer = writers_[channels::dds_topic_of(channel)];
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (true) {
+      std::vector<std::string> missing;
+      const std::vector<std::string> present = matched_reader_roles(writer);
+      for (const std::string& role : roles) {
+        if (std::find(present.begin(), present.end(), role) == present.end()) {
+          missing.push_back(role);
+        }
+      }
+      if (missing.empty() || writer == 0 || std::chrono::steady_clock::now() >= deadline) {
+        return missing;
+      }
+      dds_sleepfor(DDS_MSECS(20));
+    }
   }
 
   void unsubscribe(SubscriptionId id) override {
@@ -284,8 +337,6 @@ class DdsTransport final : public Transport {
     }
   };
 
-  static std::size_t index(ChannelClass c) { return static_cast<std::size_t>(c); }
-
   dds_entity_t check(dds_entity_t rc, const char* what) const {
     if (rc < 0) {
       throw TransportError(std::string("DDS cannot ") + what + " in domain " +
@@ -294,10 +345,37 @@ class DdsTransport final : public Transport {
     return rc;
   }
 
-  dds_entity_t create_topic(ChannelClass c) {
-    return check(dds_create_topic(participant_, &auvrl_dds_Message_desc, dds_topic_name(c), nullptr,
-                                  nullptr),
-                 "create a topic");
+  /// The roles of the readers a writer has matched (their user data, see reader_tag_).
+  static std::vector<std::string> matched_reader_roles(dds_entity_t writer) {
+    std::vector<std::string> roles;
+    if (writer == 0) return roles;
+    std::vector<dds_instance_handle_t> handles(64);
+    dds_return_t n = dds_get_matched_subscriptions(writer, handles.data(), handles.size());
+    if (n > static_cast<dds_return_t>(handles.size())) {
+      handles.resize(static_cast<std::size_t>(n));
+      n = dds_get_matched_subscriptions(writer, handles.data(), handles.size());
+    }
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(n, handles.size()); ++i) {
+      dds_builtintopic_endpoint_t* reader = dds_get_matched_subscription_data(writer, handles[i]);
+      if (reader == nullptr) continue;
+      void* data = nullptr;
+      std::size_t size = 0;
+      if (reader->qos != nullptr && dds_qget_userdata(reader->qos, &data, &size) && data) {
+        const std::string tag(static_cast<const char*>(data), size);
+        if (tag.rfind(kRoleTag, 0) == 0) roles.push_back(tag.substr(std::strlen(kRoleTag)));
+        dds_free(data);
+      }
+      dds_builtintopic_free_endpoint(reader);
+    }
+    return roles;
+  }
+
+  /// Topic t of kDdsTopics, or DDS_RETCODE_NOT_ALLOWED_BY_SECURITY when this participant may
+  /// neither publish nor subscribe to it.
+  dds_entity_t create_topic(int t) {
+    const dds_entity_t topic = dds_create_topic(participant_, &auvrl_dds_Message_desc,
+                                                channels::kDdsTopics[t].name, nullptr, nullptr);
+    return topic == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY ? topic : check(topic, "create a topic");
   }
 
   void remove(std::map<SubscriptionId, std::unique_ptr<Subscription>>::iterator it) {
@@ -370,12 +448,16 @@ class DdsTransport final : public Transport {
     }
   }
 
+  /// The user data of this transport's readers: "auvrl-role=" and its participant's role.
+  static constexpr const char* kRoleTag = "auvrl-role=";
+
   int domain_id_;
   bool lockstep_reliable_;
+  std::string reader_tag_;
   dds_entity_t participant_ = 0;
   dds_entity_t waitset_ = 0;
-  std::array<dds_entity_t, 4> writers_{};
-  std::array<std::int64_t, 4> written_{};  ///< samples written per class (acks awaited at close)
+  std::array<dds_entity_t, kTopics> writers_{};   ///< per topic; 0 where not permitted
+  std::array<std::int64_t, kTopics> written_{};  ///< samples written per topic (acks at close)
   std::map<SubscriptionId, std::unique_ptr<Subscription>> subscriptions_;
   std::vector<std::pair<SubscriptionId, dds_entity_t>> readers_;
   std::size_t next_reader_ = 0;
@@ -385,20 +467,6 @@ class DdsTransport final : public Transport {
 };
 
 }  // namespace
-
-const char* dds_topic_name(ChannelClass channel_class) {
-  switch (channel_class) {
-    case ChannelClass::kState:
-      return "auvrl_state";
-    case ChannelClass::kQueue:
-      return "auvrl_queue";
-    case ChannelClass::kLockstep:
-      return "auvrl_lockstep";
-    case ChannelClass::kOther:
-      break;
-  }
-  return "auvrl_other";
-}
 
 namespace {
 
@@ -447,8 +515,8 @@ std::vector<std::string> top_level_alternatives(std::string regex) {
   return parts;
 }
 
-/// The classes one alternative (no top-level '|') may match, from its literal prefix.
-void add_classes_of_branch(const std::string& branch, std::vector<bool>& possible) {
+/// The topics one alternative (no top-level '|') may match, from its literal prefix.
+void add_topics_of_branch(const std::string& branch, std::vector<bool>& possible) {
   // The literal prefix every match must start with: the characters before the first one
   // that is special in an extended regex.
   const std::string special = ".[]()*+?{}|^$\\";
@@ -460,54 +528,61 @@ void add_classes_of_branch(const std::string& branch, std::vector<bool>& possibl
       std::string("*?{").find(branch[end]) != std::string::npos) {
     prefix.pop_back();
   }
-  bool prefix_fixes_class = false;
-  for (const channels::ChannelClassPrefix& p : channels::kChannelClassPrefixes) {
-    const std::string class_prefix = p.prefix;
-    const bool longer = prefix.rfind(class_prefix, 0) == 0;
-    if (longer || class_prefix.rfind(prefix, 0) == 0) {
-      possible[static_cast<std::size_t>(p.channel_class)] = true;
+  // In the families' order (first match wins): a family whose prefix begins with this prefix
+  // is possible; the first whose prefix this prefix begins with decides, and ends the search.
+  for (const channels::ChannelFamily& f : channels::kChannelFamilies) {
+    const std::string family_prefix = f.prefix;
+    if (prefix.rfind(family_prefix, 0) == 0) {
+      possible[static_cast<std::size_t>(f.dds_topic)] = true;
+      return;
     }
-    prefix_fixes_class = prefix_fixes_class || longer;
+    if (family_prefix.rfind(prefix, 0) == 0) possible[static_cast<std::size_t>(f.dds_topic)] = true;
   }
-  // Channels of no listed prefix are kOther: possible unless the prefix already begins with a
-  // class's prefix.
-  if (!prefix_fixes_class) possible[static_cast<std::size_t>(ChannelClass::kOther)] = true;
+  // Channels of no family go to the last topic.
+  possible[static_cast<std::size_t>(channels::kOtherDdsTopic)] = true;
 }
 
-/// Marks the classes a regex may match in possible (alternatives analysed one by one).
-void add_classes(const std::string& regex, std::vector<bool>& possible) {
+/// Marks the topics a regex may match in possible (alternatives analysed one by one).
+void add_topics(const std::string& regex, std::vector<bool>& possible) {
   const std::vector<std::string> parts = top_level_alternatives(regex);
   if (parts.size() > 1) {
-    for (const std::string& part : parts) add_classes(part, possible);
+    for (const std::string& part : parts) add_topics(part, possible);
   } else if (parts[0].find('|') != std::string::npos) {
-    // A nested alternation ("A(B|C)"): not analysed, every class is possible.
+    // A nested alternation ("A(B|C)"): not analysed, every topic is possible.
     std::fill(possible.begin(), possible.end(), true);
   } else {
-    add_classes_of_branch(parts[0], possible);
+    add_topics_of_branch(parts[0], possible);
   }
 }
 
 }  // namespace
 
-std::vector<ChannelClass> classes_possibly_matching(const std::string& channel_regex) {
-  std::vector<bool> possible(kAllClasses.size(), false);
-  add_classes(channel_regex, possible);
-  std::vector<ChannelClass> out;
-  for (ChannelClass c : kAllClasses) {
-    if (possible[static_cast<std::size_t>(c)]) out.push_back(c);
+std::vector<int> topics_possibly_matching(const std::string& channel_regex) {
+  std::vector<bool> possible(static_cast<std::size_t>(kTopics), false);
+  add_topics(channel_regex, possible);
+  std::vector<int> out;
+  for (int t = 0; t < kTopics; ++t) {
+    if (possible[static_cast<std::size_t>(t)]) out.push_back(t);
   }
   return out;
 }
 
 void check_dds_settings(const DdsSettings& s, bool allow_off_host) {
-  if (s.domain_id < 0 || s.domain_id > 232) {
-    throw TransportError("DDS domain id " + std::to_string(s.domain_id) +
-                         " is out of range (0..232)");
+  const bool secured = !s.security_dir.empty();
+  const int max_domain = secured ? kSecuredMaxDomainId : 232;
+  if (s.domain_id < 0 || s.domain_id > max_domain) {
+    throw TransportError("DDS domain id " + std::to_string(s.domain_id) + " is out of range (0.." +
+                         std::to_string(max_domain) + (secured ? " with DDS Security)" : ")"));
   }
   if (s.max_auto_participant_index < 1) {
     throw TransportError("DDS max_auto_participant_index must be >= 1");
   }
   if (!s.config_path.empty()) {
+    if (secured) {
+      throw TransportError("DDS Security (--dds-security) and a Cyclone configuration file ('" +
+                           s.config_path +
+                           "') do not go together: put the <Security> section in the file");
+    }
     if (access(s.config_path.c_str(), R_OK) != 0) {
       throw TransportError("DDS configuration file '" + s.config_path + "' cannot be read");
     }
@@ -523,10 +598,11 @@ void check_dds_settings(const DdsSettings& s, bool allow_off_host) {
     if (peer.empty() || peer.find_first_of("<>&\"' \t\n") != std::string::npos) {
       throw TransportError("DDS peer '" + peer + "' is not a host name or address");
     }
-    if (!is_loopback_peer(peer) && !allow_off_host) {
+    if (!is_loopback_peer(peer) && !allow_off_host && !secured) {
       throw TransportError("refusing DDS peer '" + peer +
                            "': traffic to it leaves this host, and DDS here has no "
-                           "authentication; pass --allow-off-host to accept it");
+                           "authentication; pass --allow-off-host to accept it, or secure the "
+                           "bus with --dds-security");
     }
   }
 }
@@ -541,12 +617,19 @@ std::string dds_default_config_xml(const DdsSettings& s) {
   for (const std::string& peer : s.peers) xml += R"(<Peer address=")" + peer + R"("/>)";
   xml += "</Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
          std::to_string(s.max_auto_participant_index) +
-         "</MaxAutoParticipantIndex></Discovery></Domain></CycloneDDS>";
-  return xml;
+         "</MaxAutoParticipantIndex></Discovery>";
+  if (!s.security_dir.empty()) {
+    xml += dds_security_config_xml(resolve_dds_security(s.security_dir, s.security_identity));
+  }
+  return xml + "</Domain></CycloneDDS>";
 }
 
 std::unique_ptr<Transport> make_dds_transport(const DdsSettings& settings, bool allow_off_host) {
   check_dds_settings(settings, allow_off_host);
+  if (!settings.security_dir.empty()) {
+    check_dds_security_files(resolve_dds_security(settings.security_dir,
+                                                  settings.security_identity));
+  }
   const std::string config = settings.config_path.empty() ? dds_default_config_xml(settings)
                                                           : "file://" + settings.config_path;
   return std::make_unique<DdsTransport>(settings, config);

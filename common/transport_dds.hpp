@@ -45,12 +45,9 @@ void check_dds_settings(const DdsSettings& settings, bool allow_off_host);
 /// participant index auto up to settings.max_auto_participant_index.
 std::string dds_default_config_xml(const DdsSettings& settings);
 
-/// The DDS topic that carries a channel class.
-const char* dds_topic_name(channels::ChannelClass channel_class);
-
-/// The channel classes that a channel matching the full-match regex may belong to: a superset,
-/// decided from the regex's literal prefix (".*" gives all four, "SIM_CMD_[0-9]+" only
-/// kLockstep). A subscription reads only these classes' topics.
-std::vector<channels::ChannelClass> classes_possibly_matching(const std::string& channel_regex);
+/// The topics (indices into channels::kDdsTopics) that a channel matching the full-match regex
+/// may be carried on: a superset, decided from the regex's literal prefix (".*" gives all,
+/// "SIM_CMD_[0-9]+" only auvrl_sim_command). A subscription reads only these topics.
+std::vector<int> topics_possibly_matching(const std::string& channel_regex);
 
 }  // namespace auvrl::transport

@@ -6,20 +6,25 @@
 
 namespace auvrl::transport {
 
-std::vector<std::string> parse_peer_list(const std::string& text) {
-  std::vector<std::string> peers;
+std::vector<std::string> parse_comma_list(const std::string& text, const std::string& what) {
+  std::vector<std::string> items;
   std::size_t pos = 0;
   while (true) {
     const auto comma = text.find(',', pos);
     const std::string item =
         text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
     if (item.empty()) {
-      throw TransportError("empty item in the peer list '" + text + "' (expected host[,host...])");
+      throw TransportError("empty item in the " + what + " list '" + text + "' (expected " +
+                           what + "[," + what + "...])");
     }
-    peers.push_back(item);
-    if (comma == std::string::npos) return peers;
+    items.push_back(item);
+    if (comma == std::string::npos) return items;
     pos = comma + 1;
   }
+}
+
+std::vector<std::string> parse_peer_list(const std::string& text) {
+  return parse_comma_list(text, "host");
 }
 
 void add_transport_options(cli::CommandLine& cmd, TransportConfig& config,
@@ -69,6 +74,22 @@ void add_transport_options(cli::CommandLine& cmd, TransportConfig& config,
         record("dds-config", v);
       },
       "", "a Cyclone XML file replacing the generated configuration (needs --allow-off-host)");
+  cmd.custom_option(
+      "dds-security",
+      [&config, record](const std::string& v) {
+        config.dds.security_dir = v;
+        record("dds-security", v);
+      },
+      "",
+      "DDS Security: a directory made by scripts/pki.sh, or one participant's directory in it "
+      "(authentication, access control, encryption)");
+  cmd.custom_option(
+      "dds-identity",
+      [&config, record](const std::string& v) {
+        config.dds.security_identity = v;
+        record("dds-identity", v);
+      },
+      "", "DDS Security: this participant's name in the --dds-security directory (actor-0, ...)");
   cmd.custom_flag(
       "dds-lockstep-best-effort",
       [&config, record] {
@@ -124,6 +145,12 @@ std::vector<std::string> transport_arguments(const TransportConfig& config) {
       args.insert(args.end(), {"--dds-config", config.dds.config_path});
     }
   }
+  if (config.kind == TransportKind::kDds && !config.dds.security_dir.empty()) {
+    args.insert(args.end(), {"--dds-security", config.dds.security_dir});
+    if (!config.dds.security_identity.empty()) {
+      args.insert(args.end(), {"--dds-identity", config.dds.security_identity});
+    }
+  }
   if (config.kind == TransportKind::kDds && !config.dds.lockstep_reliable) {
     args.push_back("--dds-lockstep-best-effort");
   }
@@ -145,7 +172,7 @@ config::Table<TransportConfig> make_transport_table() {
   using C = TransportConfig;
   config::Table<C> t("transport",
                      "the transport of every process (flags: --transport, --lcm-url, "
-                     "--dds-domain, --dds-peers, --dds-config, --allow-off-host)");
+                     "--dds-domain, --dds-peers, --dds-config, --dds-security, --allow-off-host)");
   t.text_field(
       "kind", &C::kind, parse_transport_kind, [](TransportKind k) { return to_string(k); },
       "one of lcm, dds", "", "LCM (UDP multicast) or Cyclone DDS (unicast discovery)");
@@ -165,6 +192,11 @@ config::Table<TransportConfig> make_transport_table() {
       "dds_config", [](C& c) -> std::string& { return c.dds.config_path; },
       "path, relative to the configuration file",
       "a Cyclone XML file replacing the generated configuration (needs allow_off_host)");
+  t.field(
+      "dds_security", [](C& c) -> std::string& { return c.dds.security_dir; },
+      "path, relative to the configuration file",
+      "DDS Security: a directory made by scripts/pki.sh (authentication, access control, "
+      "encryption)");
   t.field("allow_off_host", &C::allow_off_host, "",
           "accept a transport whose traffic can leave this host (no authentication!)");
   return t;
@@ -182,6 +214,9 @@ void read_transport_section(config::Section s, TransportConfig& config) {
   if (s.has("dds_config")) {
     config.dds.config_path = config::resolve_path(s, config.dds.config_path);
   }
+  if (s.has("dds_security")) {
+    config.dds.security_dir = config::resolve_path(s, config.dds.security_dir);
+  }
   s.finish();
   // Name the key that widens the configuration: the URL for LCM, the DDS settings otherwise.
   try {
@@ -194,7 +229,8 @@ void read_transport_section(config::Section s, TransportConfig& config) {
   try {
     if (config.kind == TransportKind::kDds) check_dds_settings(config.dds, config.allow_off_host);
   } catch (const TransportError& e) {
-    s.fail(s.has("dds_config")  ? "dds_config"
+    s.fail(s.has("dds_config")     ? "dds_config"
+           : s.has("dds_security") ? "dds_security"
            : s.has("dds_peers") ? "dds_peers"
                                 : "kind",
            e.what());

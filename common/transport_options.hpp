@@ -1,6 +1,6 @@
 // The transport's configuration as every process and the launcher take it: the same command-
 // line flags everywhere (--transport lcm|dds, --lcm-url, --dds-domain, --dds-peers,
-// --dds-config, --allow-off-host), the `transport:` section of a run configuration, the flags
+// --dds-config, --dds-security, --allow-off-host), the `transport:` section of a run configuration, the flags
 // that pass a configuration on to a child process, and the private lockstep bus of a
 // simulator/actor pair.
 #pragma once
@@ -15,6 +15,9 @@
 #include "common/transport.hpp"
 
 namespace auvrl::transport {
+
+/// Parses a comma-separated list ("a,b"); an empty item is an error naming what the items are.
+std::vector<std::string> parse_comma_list(const std::string& text, const std::string& what);
 
 /// Parses a comma-separated list of DDS peers ("127.0.0.1,10.0.0.2"); empty items are errors.
 std::vector<std::string> parse_peer_list(const std::string& text);
@@ -57,6 +60,7 @@ void apply_transport_arguments(const std::vector<std::string>& args, TransportCo
 ///     dds_domain: 0            # DDS domain id
 ///     dds_peers: 127.0.0.1     # comma-separated hosts
 ///     dds_config: cyclone.xml  # a Cyclone XML file (relative to the configuration file)
+///     dds_security: pki        # scripts/pki.sh's directory (relative to it too)
 ///     allow_off_host: false
 void read_transport_section(config::Section section, TransportConfig& config);
 

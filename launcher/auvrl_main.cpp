@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/cli.hpp"
+#include "common/dds_security.hpp"
 #include "common/signature.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
@@ -387,6 +388,42 @@ int run_verify(int argc, const char* const* argv) {
                            });
 }
 
+int run_dds_policy(int argc, const char* const* argv) {
+  std::string role, not_before = "2026-01-01T00:00:00", not_after;
+  std::vector<std::string> subjects, documents;
+  auvrl::cli::CommandLine cli(
+      "auvrl dds-policy",
+      "Prints a DDS Security document, unsigned (scripts/pki.sh signs it): `governance`, or "
+      "`permissions --role ROLE --subject S...` (one grant per subject) or `roles`.");
+  cli.positionals("document", &documents, "governance, permissions or roles");
+  cli.option("role", &role, "permissions: the role (learner, actor, simulator, controller, "
+                            "logger, operator, observer)");
+  cli.repeatable("subject", &subjects,
+                 "permissions: a participant's certificate subject, e.g. CN=actor-0,O=auvrl "
+                 "(repeat the flag for each)");
+  cli.option("not-before", &not_before, "permissions: valid from (YYYY-MM-DDTHH:MM:SS)");
+  cli.option("not-after", &not_after, "permissions: valid until (YYYY-MM-DDTHH:MM:SS)");
+  if (!cli.parse(argc, argv)) return 0;
+  const std::string document = documents.size() == 1 ? documents[0] : "";
+  if (document == "governance") {
+    std::cout << auvrl::transport::dds_governance_xml();
+  } else if (document == "roles") {
+    for (const auto& r : auvrl::transport::dds_roles()) {
+      std::cout << r.name << "\t" << r.description << "\n";
+    }
+  } else if (document == "permissions") {
+    if (role.empty() || subjects.empty() || not_after.empty()) {
+      throw auvrl::cli::UsageError("permissions needs --role, --subject and --not-after");
+    }
+    std::cout << auvrl::transport::dds_permissions_xml(auvrl::transport::dds_role(role), subjects,
+                                                       not_before, not_after);
+  } else {
+    throw auvrl::cli::UsageError("expected governance, permissions or roles, got '" + document +
+                                 "'");
+  }
+  return 0;
+}
+
 struct Subcommand {
   const char* name;
   const char* summary;
@@ -411,6 +448,8 @@ const Subcommand kSubcommands[] = {
      run_tune_pid},
     {"config-doc", "print the configuration reference (docs/configuration.md)", run_config_doc},
     {"keygen", "write an Ed25519 key pair for signing policies and missions", run_keygen},
+    {"dds-policy", "print a DDS Security governance or permissions document (scripts/pki.sh)",
+     run_dds_policy},
     {"sign", "sign policy or mission files (FILE.sig) for auv_controller --trust-key", run_sign},
     {"verify", "check files against their signatures with a public key", run_verify},
 };

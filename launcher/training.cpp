@@ -21,6 +21,7 @@
 #include "common/nn/serialize.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
+#include "common/dds_security.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "launcher/format.hpp"
@@ -90,6 +91,35 @@ RoleSpec fixed_role(const RunContext& ctx, std::string name, RoleKind kind,
           -1};
 }
 
+/// The DDS Security identity of participant `name` (scripts/pki.sh's names: learner, logger,
+/// launcher, actor-I, sim-I), when the run is secured.
+std::vector<std::string> identity_args(const RunContext& ctx, const std::string& name) {
+  const transport::TransportConfig& t = ctx.rc.transport;
+  if (t.kind != transport::TransportKind::kDds || t.dds.security_dir.empty()) return {};
+  return {"--dds-identity", name};
+}
+
+/// A secured run refuses to start unless scripts/pki.sh's directory holds a valid identity for
+/// every participant it will start (a missing actor-3 is named before anything runs).
+void check_identities(const RunContext& ctx) {
+  if (identity_args(ctx, "launcher").empty()) return;
+  std::vector<std::string> names = {"launcher", "learner", "logger"};
+  for (int i = 0; i < ctx.actors; ++i) {
+    names.push_back("actor-" + std::to_string(i));
+    names.push_back("sim-" + std::to_string(i));
+  }
+  const std::string& dir = ctx.rc.transport.dds.security_dir;
+  if (fs::exists(fs::path(dir) / "cert.pem")) {
+    throw transport::TransportError(
+        "DDS Security: " + dir +
+        " is one participant's directory; auvrl train needs the whole directory that "
+        "scripts/pki.sh made (it gives each process its own identity)");
+  }
+  for (const std::string& name : names) {
+    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
+  }
+}
+
 /// The private lockstep bus of pair i: an LCM port, or a DDS domain, of its own.
 std::vector<std::string> lockstep_args(const RunContext& ctx, int i) {
   if (!ctx.rc.run.private_lockstep_bus) return {};
@@ -147,8 +177,11 @@ RoleSpec actor_role(const RunContext& ctx, int i, int cpu, const std::string& bi
                     const std::vector<std::string>& transport_args) {
   const std::uint64_t seed = ctx.rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
   const std::uint64_t restart_seed_step = ctx.rc.run.reproducible ? 0 : 7919;
-  const std::vector<std::string> rest =
-      concat(reproducible_args(ctx), concat(lockstep_args(ctx, i), transport_args));
+  // Its first episode waits until the learner and the logger read its experience (DDS).
+  const std::vector<std::string> rest = concat(
+      concat(reproducible_args(ctx), concat(lockstep_args(ctx, i), transport_args)),
+      concat(identity_args(ctx, "actor-" + std::to_string(i)),
+             {"--wait-for-readers", "learner,logger"}));
   const std::string config_path = ctx.config_path;
   RoleSpec role = fixed_role(ctx, "actor" + std::to_string(i), RoleKind::kActor, {});
   role.actor_id = i;
@@ -171,7 +204,8 @@ std::vector<RoleSpec> make_roles(const RunContext& ctx,
   std::vector<RoleSpec> roles;
   roles.push_back(fixed_role(
       ctx, "logger", RoleKind::kLogger,
-      concat({bin + "auv_logger", "--dir", (run_dir / "logs").string()}, transport_args)));
+      concat(concat({bin + "auv_logger", "--dir", (run_dir / "logs").string()}, transport_args),
+             identity_args(ctx, "logger"))));
   // Actors (each beside its simulator) on the CPUs the learner does not have, if any.
   std::vector<int> actor_cpus;
   for (int c = 0; c < ctx.cpus; ++c) {
@@ -185,11 +219,13 @@ std::vector<RoleSpec> make_roles(const RunContext& ctx,
                                      bin + "auv_sim",    "--vehicle", ctx.rc.vehicle_path,
                                      "--vehicles",       "1",         "--first-vehicle-id",
                                      std::to_string(i)};
-    argv = concat(concat(argv, lockstep_args(ctx, i)), transport_args);
+    argv = concat(concat(argv, lockstep_args(ctx, i)),
+                  concat(transport_args, identity_args(ctx, "sim-" + std::to_string(i))));
     roles.push_back(fixed_role(ctx, "sim" + std::to_string(i), RoleKind::kSim, argv));
   }
   RoleSpec learner = fixed_role(ctx, "learner", RoleKind::kLearner, {});
-  const std::vector<std::string> base = concat(learner_argv(ctx, bin), transport_args);
+  const std::vector<std::string> base =
+      concat(learner_argv(ctx, bin), concat(transport_args, identity_args(ctx, "learner")));
   const std::string checkpoints = (run_dir / "checkpoints").string();
   learner.argv = [base, checkpoints](std::size_t) {
     return has_checkpoint_file(checkpoints) ? concat(base, {"--resume"}) : base;
@@ -293,7 +329,10 @@ class TrainingSession {
 };
 
 void TrainingSession::subscribe() {
-  transport_ = transport::make_transport(ctx_.rc.transport);
+  transport::TransportConfig config = ctx_.rc.transport;
+  config.dds.role = "observer";
+  config.dds.security_identity = "launcher";
+  transport_ = transport::make_transport(config);
   transport::subscribe<auvrl_lcm::episode_report_t>(
       *transport_, channels::kEpisode,
       [this](const std::string&, const auvrl_lcm::episode_report_t& e) {
@@ -333,6 +372,7 @@ void TrainingSession::subscribe() {
 }
 
 void TrainingSession::start_processes() {
+  check_identities(ctx_);
   const std::vector<std::string> transport_args = transport::transport_arguments(ctx_.rc.transport);
   for (RoleSpec& role : make_roles(ctx_, transport_args)) supervisor_.add(std::move(role));
   const fs::path proc_dir = fs::path(ctx_.run_dir) / "processes";

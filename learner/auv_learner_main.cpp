@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   cmd.flag("keep-running", &options.keep_running, "keep serving after training is done");
   cmd.option("threads", &options.threads, "threads for the matrix products");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "learner";
   cmd.flag("bench", &options.bench,
            "print updates/s for 64-64 batch 100, 256-256 batch 256, 400-300 batch 64 (or the one "
            "case --hidden/--batch-size give) and exit");

@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   cmd.option("queue-capacity", &config.queue_capacity,
              "messages the transport may hold between polls");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "logger";
   try {
     if (!cmd.parse(argc, argv)) return 0;
     logger::add_throttle_rules(throttles, config);

@@ -11,9 +11,11 @@
 # (the probe, build/bin/multihost_probe, counts what reaches its namespace)
 #
 #   scripts/multihost.sh [--transport dds|lcm] [--links no-multicast|multicast] [--lcm-ttl N]
-#                        [--loss PCT] [--seconds S] [--hidden H] [--out DIR] [--check]
+#                        [--loss PCT] [--seconds S] [--hidden H] [--security] [--out DIR]
+#                        [--check]
 #   scripts/multihost.sh --ci       the CTest form (test_multihost): DDS with --loss 5 --check,
-#                                   then LCM on the same links, where nothing may cross
+#                                   then DDS with --security --check, then LCM on the same
+#                                   links, where nothing may cross
 #
 # --links no-multicast (default): `ip link set eth0 multicast off` on every link, no multicast
 #   route on them (224.0.0.0/4 goes to lo, as in every private namespace of this project, so
@@ -29,6 +31,17 @@
 #   updates happened, the logger logged every episode; LCM with --links no-multicast: nothing
 #   crossed a link). Exit 77 when namespaces cannot be made (no root, no user namespaces).
 #
+# --security (DDS): every process authenticated, access-controlled and encrypted (DDS Security,
+#   a PKI made by scripts/pki.sh in DIR/pki), and a fourth namespace D (10.77.0.4), an
+#   intruder's host, where build/bin/multihost_intruder tries to inject experience, episodes,
+#   weights and thruster commands and to read the traffic, four times at once: without a
+#   certificate (plain), with a certificate of another authority (other-ca), with the run's
+#   certificate but a role whose permissions do not allow those topics (wrong-role), and with
+#   the run's certificate and permissions it granted itself, signed by another authority
+#   (self-granted). --check then also requires that nothing of theirs reached a probe, the
+#   learner or the logger and that they received nothing, and that a learner given a tampered
+#   permissions document is refused at start.
+#
 # Figures: the probes' lines (multihost_probe.cpp), the logger's channel counts (auv_log list)
 # and a summary; everything stays in DIR (default runs/multihost-TIME) with the logs.
 set -euo pipefail
@@ -40,6 +53,7 @@ self=$(readlink -f "$0")
 usage() { sed -n '2,33p' "$self" | sed 's/^# \{0,1\}//'; exit 2; }
 
 transport=dds links=no-multicast ttl=0 loss=0 seconds=20 hidden=32-32 out="" check=0 ci=0
+security=0
 inside=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -51,6 +65,7 @@ while [ $# -gt 0 ]; do
     --hidden) hidden=$2; shift 2 ;;
     --out) out=$2; shift 2 ;;
     --check) check=1; shift ;;
+    --security) security=1; shift ;;
     --ci) ci=1; shift ;;
     --inside) inside=1; shift ;;
     -h|--help) usage ;;
@@ -59,7 +74,8 @@ while [ $# -gt 0 ]; do
 done
 case "$transport" in dds|lcm) ;; *) usage ;; esac
 case "$links" in no-multicast|multicast) ;; *) usage ;; esac
-for b in auv_sim auv_actor auv_learner auv_logger auv_log multihost_probe; do
+[ "$security" = 0 ] || [ "$transport" = dds ] || { echo "multihost: --security needs DDS" >&2; usage; }
+for b in auv_sim auv_actor auv_learner auv_logger auv_log multihost_probe multihost_intruder; do
   [ -x "$bin/$b" ] || { echo "multihost: $bin/$b is missing (build it first)" >&2; exit 1; }
 done
 
@@ -69,10 +85,39 @@ if [ "$ci" = 1 ]; then
   status=0
   "$self" --transport dds --loss 5 --seconds 20 --check --out "$base/dds" || status=$?
   [ "$status" = 0 ] || exit "$status"
+  "$self" --transport dds --security --seconds 15 --check --out "$base/dds-security" || status=$?
+  [ "$status" = 0 ] || exit "$status"
   "$self" --transport lcm --seconds 8 --check --out "$base/lcm" || status=$?
   [ "$status" = 0 ] && rm -rf "$base"
   exit "$status"
 fi
+
+# The PKIs of --security (no network needed): the run's (DIR/pki: the system, the probes and
+# two intruders' certificates), another authority's (DIR/pki-other), and the self-granted
+# intruder's permissions (every topic), signed by that other authority.
+make_pki() {
+  local dir=$1 p subject
+  rm -rf "$dir/pki" "$dir/pki-other"
+  "$root/scripts/pki.sh" --out "$dir/pki" --actors 2 --controllers 0 --days 2 \
+    --participant observer:probe-A --participant observer:probe-B \
+    --participant observer:probe-C --participant simulator:intruder-wrong-role \
+    --participant operator:intruder-self-granted >/dev/null
+  "$root/scripts/pki.sh" --out "$dir/pki-other" --actors 1 --controllers 0 --days 2 >/dev/null
+  p="$dir/pki/intruder-self-granted"
+  subject=$(openssl x509 -in "$p/cert.pem" -noout -subject -nameopt RFC2253 | sed 's/^subject=//')
+  cat >"$p/permissions.xml" <<EOF
+<?xml version="1.0" encoding="UTF-8"?>
+<dds><permissions><grant name="self"><subject_name>$subject</subject_name>
+<validity><not_before>$(date -u -d '-1 hour' +%Y-%m-%dT%H:%M:%S)</not_before><not_after>$(date -u -d '+1 day' +%Y-%m-%dT%H:%M:%S)</not_after></validity>
+<allow_rule><domains><id_range><min>0</min><max>230</max></id_range></domains>
+<publish><topics><topic>*</topic></topics></publish><subscribe><topics><topic>*</topic></topics></subscribe>
+</allow_rule><default>DENY</default></grant></permissions></dds>
+EOF
+  openssl smime -sign -in "$p/permissions.xml" -text -out "$p/permissions.p7s" \
+    -signer "$dir/pki-other/ca/ca.pem" -inkey "$dir/pki-other/ca/ca.key"
+  cp "$dir/pki-other/ca/ca.pem" "$p/permissions_ca.pem"
+  cp "$dir/pki-other/governance.p7s" "$p/governance.p7s"
+}
 
 # --- Outside: a private network, PID and mount namespace for everything below. -------------
 if [ "$inside" = 0 ]; then
@@ -87,12 +132,14 @@ if [ "$inside" = 0 ]; then
   fi
   check_flag=()
   [ "$check" = 0 ] || check_flag=(--check)
+  security_flag=()
+  [ "$security" = 0 ] || { make_pki "$out"; security_flag=(--security); }
   # unshare ignores SIGTERM/SIGINT while it waits: unshare_supervised passes them to PID 1
   # inside, which stops what it started; when PID 1 ends, the kernel ends every process left
   # in its namespace (and --kill-child ends PID 1 if unshare itself is killed).
   unshare_supervised "" "${flags[@]}" -- "$self" --inside --transport "$transport" \
     --links "$links" --lcm-ttl "$ttl" --loss "$loss" --seconds "$seconds" --hidden "$hidden" \
-    --out "$out" "${check_flag[@]}"
+    --out "$out" "${check_flag[@]}" "${security_flag[@]}"
 fi
 
 # --- Inside: PID 1 of the private namespaces, in the bridge's network namespace. -----------
@@ -111,11 +158,12 @@ trap 'exit 130' INT TERM
 
 log() { echo "multihost: $*" >&2; }
 names=(A B C)
+[ "$security" = 0 ] || names+=(D)  # the intruders' host
 declare -A holder addr
 ip link set lo up
 ip link add br0 type bridge mcast_snooping 0
 ip link set br0 up
-for i in 0 1 2; do
+for i in "${!names[@]}"; do
   n=${names[$i]}
   addr[$n]=10.77.0.$((i + 1))
   # A process that holds namespace n open (the processes placed there join it with nsenter).
@@ -173,7 +221,9 @@ nsenter -t "${holder[A]}" -n -- ip route >>"$out/links.txt"
 # correct, since these addresses exist only on the veth links of this script's private
 # namespaces and no packet can reach a real network.
 if [ "$transport" = dds ]; then
-  common=(--transport dds --dds-peers "${addr[A]},${addr[B]},${addr[C]}" --allow-off-host)
+  common=(--transport dds --dds-peers "${addr[A]},${addr[B]},${addr[C]}")
+  # Secured, the bus admits only the run's participants: off-host peers need no opt-out.
+  [ "$security" = 1 ] || common+=(--allow-off-host)
   lockstep_a=(--lockstep-dds-domain 1)
   lockstep_c=(--lockstep-dds-domain 2)
 else
@@ -182,6 +232,12 @@ else
   lockstep_a=(--lockstep-lcm-url "udpm://239.255.76.67:7668?ttl=0")
   lockstep_c=(--lockstep-lcm-url "udpm://239.255.76.67:7669?ttl=0")
 fi
+
+# identity NAME: the flags of participant NAME's identity (--security), in id_flags.
+identity() {
+  id_flags=()
+  [ "$security" = 0 ] || id_flags=(--dds-security "$out/pki/$1")
+}
 
 declare -A pid_of
 start() {  # start NAME NAMESPACE CMD...: runs CMD in NAMESPACE, output in $out/NAME.log
@@ -202,20 +258,60 @@ stop() {  # stop NAME...: SIGTERM, then wait up to 10 s (SIGKILL after)
   done
 }
 
+if [ "$security" = 1 ]; then
+  # A tampered permissions document (the learner's, granting what it did not) is refused at
+  # start, naming the file.
+  cp -r "$out/pki/learner" "$out/tampered-learner"
+  sed -i 's|<topic>auvrl_weights</topic>|<topic>auvrl_experience</topic><topic>auvrl_weights</topic>|' \
+    "$out/tampered-learner/permissions.p7s"
+  tampered_status=0
+  nsenter -t "${holder[B]}" -n -- timeout 20 "$bin/auv_learner" "${common[@]}" \
+    --dds-security "$out/tampered-learner" >"$out/tampered-learner.log" 2>&1 || tampered_status=$?
+  log "learner with a tampered permissions document: exit $tampered_status: $(head -c 300 "$out/tampered-learner.log")"
+fi
 for n in A B C; do
-  start "probe$n" "$n" "$bin/multihost_probe" --label "$n" --out "$out/probe$n.txt" "${common[@]}"
+  identity "probe-$n"
+  start "probe$n" "$n" "$bin/multihost_probe" --label "$n" --out "$out/probe$n.txt" "${common[@]}" \
+    "${id_flags[@]}"
 done
-start learner B "$bin/auv_learner" "${common[@]}" --algo td3 --hidden "$hidden" --batch-size 64 \
+identity learner
+start learner B "$bin/auv_learner" "${common[@]}" "${id_flags[@]}" --algo td3 --hidden "$hidden" --batch-size 64 \
   --layout extended --replay-capacity 100000 --updates-per-transition 0.25 --warmup-transitions 500
-start logger C "$bin/auv_logger" "${common[@]}" --dir "$out/logs" --heartbeat-period 0.5 \
+identity logger
+start logger C "$bin/auv_logger" "${common[@]}" "${id_flags[@]}" --dir "$out/logs" --heartbeat-period 0.5 \
   --channels 'EXPERIENCE|EPISODE|POLICY_.*|LEARNER_STATS|SIM_HEARTBEAT'
-start simA A "$bin/auv_sim" "${common[@]}" "${lockstep_a[@]}" --vehicles 1 --first-vehicle-id 0
-start simC C "$bin/auv_sim" "${common[@]}" "${lockstep_c[@]}" --vehicles 1 --first-vehicle-id 1
-actor_args=(--layout extended --reward shaped --max-steps 100 --noise gaussian)
-start actorA A "$bin/auv_actor" "${common[@]}" "${lockstep_a[@]}" --actor-id 0 --seed 10 \
-  "${actor_args[@]}"
-start actorC C "$bin/auv_actor" "${common[@]}" "${lockstep_c[@]}" --actor-id 1 --seed 11 \
-  "${actor_args[@]}"
+identity sim-0
+start simA A "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_a[@]}" --vehicles 1 \
+  --first-vehicle-id 0
+identity sim-1
+start simC C "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_c[@]}" --vehicles 1 \
+  --first-vehicle-id 1
+# An actor's first episode waits until the learner and the logger read its experience.
+actor_args=(--layout extended --reward shaped --max-steps 100 --noise gaussian
+  --wait-for-readers learner,logger)
+identity actor-0
+start actorA A "$bin/auv_actor" "${common[@]}" "${id_flags[@]}" "${lockstep_a[@]}" --actor-id 0 \
+  --seed 10 "${actor_args[@]}"
+identity actor-1
+start actorC C "$bin/auv_actor" "${common[@]}" "${id_flags[@]}" "${lockstep_c[@]}" --actor-id 1 \
+  --seed 11 "${actor_args[@]}"
+intruders=()
+if [ "$security" = 1 ]; then
+  # The intruders on their own host D, knowing every address; the system does not list D.
+  intruder_peers=(--transport dds --dds-peers "${addr[A]},${addr[B]},${addr[C]},${addr[D]}")
+  declare -A intruder_flags=(
+    [plain]="--allow-off-host"
+    [other-ca]="--dds-security $out/pki-other/actor-0"
+    [wrong-role]="--dds-security $out/pki/intruder-wrong-role"
+    [self-granted]="--dds-security $out/pki/intruder-self-granted")
+  for n in plain other-ca wrong-role self-granted; do
+    # shellcheck disable=SC2206  # the flags above split on spaces (paths have none)
+    flags=(${intruder_flags[$n]})
+    start "intruder-$n" D "$bin/multihost_intruder" --label "$n" --out "$out/intruder-$n.txt" \
+      "${intruder_peers[@]}" "${flags[@]}"
+    intruders+=("intruder-$n")
+  done
+fi
 log "$transport: training for ${seconds} s (logs in $out)"
 # Loss starts after a lossless warm-up: DDS delivers reliably to the readers it has discovered
 # (volatile durability), and an actor's first episode report, ~10-50 ms after it starts, can
@@ -238,10 +334,10 @@ stop actorA actorC
 sleep 3
 stop learner
 sleep 1
-stop probeA probeB probeC
+stop probeA probeB probeC "${intruders[@]}"
 stop simA simC logger
 "$bin/auv_log" list "$out/logs" >"$out/logger_channels.txt" 2>&1 || true
-for n in A B C; do  # what went over each link (the namespace's end of it)
+for n in "${names[@]}"; do  # what went over each link (the namespace's end of it)
   echo "namespace $n:"
   nsenter -t "${holder[$n]}" -n -- ip -s link show eth0
   nsenter -t "${holder[$n]}" -n -- nft list ruleset 2>/dev/null || true
@@ -255,6 +351,7 @@ reasm=$(nsenter -t "${holder[B]}" -n -- awk '/^Ip:/ { if (!h) { for (i = 1; i <=
 
 # --- Figures. --------------------------------------------------------------------------------
 cat "$out"/probe{A,B,C}.txt
+for n in "${intruders[@]}"; do cat "$out/$n.txt" 2>/dev/null || echo "intruder=$n: no figures"; done
 echo "logger (namespace C), auv_log list:"
 sed 's/^/  /' "$out/logger_channels.txt"
 field() {  # field FILE LINE_PATTERN KEY: the KEY=value on the first line matching the pattern
@@ -262,16 +359,23 @@ field() {  # field FILE LINE_PATTERN KEY: the KEY=value on the first line matchi
   v=$(grep -E "$2" "$1" 2>/dev/null | head -1 | tr ' ' '\n' | sed -n "s/^$3=//p")
   echo "${v:-0}"
 }
-sent_a=$(field "$out/probeA.txt" "experience actor=0 " transitions)
-sent_c=$(field "$out/probeC.txt" "experience actor=1 " transitions)
+# What each actor sent and how many episodes it ran, in its own words (its last log line; a
+# probe may join after an actor's first episode).
+actor_figure() {  # actor_figure LOG WORD: the number before WORD on the "stopped after" line
+  local v
+  v=$(grep "stopped after" "$1" 2>/dev/null | tail -1 | grep -oE "[0-9]+ $2" | grep -oE '^[0-9]+')
+  echo "${v:-0}"
+}
+sent_a=$(actor_figure "$out/actorA.log" "transitions sent")
+sent_c=$(actor_figure "$out/actorC.log" "transitions sent")
 received=$(field "$out/probeB.txt" "learner " transitions_received)
 lost=$(field "$out/probeB.txt" "learner " batches_lost)
 updates=$(field "$out/probeB.txt" "learner " updates)
 learner_episodes=$(field "$out/probeB.txt" "learner " episodes)
 published=$(field "$out/probeB.txt" "learner " weights_published)
 newest=$(field "$out/probeB.txt" "weights " newest)  # B: beside the learner, nothing lost
-episodes_a=$(field "$out/probeA.txt" "episodes actor=0 " count)
-episodes_c=$(field "$out/probeC.txt" "episodes actor=1 " count)
+episodes_a=$(actor_figure "$out/actorA.log" "episodes")
+episodes_c=$(actor_figure "$out/actorC.log" "episodes")
 policy_a=$(field "$out/probeB.txt" "episodes actor=0 " policy_last)
 policy_c=$(field "$out/probeB.txt" "episodes actor=1 " policy_last)
 weights_a=$(field "$out/probeA.txt" "weights " versions)
@@ -310,6 +414,22 @@ if [ "$transport" = dds ]; then
   expect "the newest weights reached A and C" test "$newest_a" -eq "$newest" -a "$newest_c" -eq "$newest"
   expect "both actors acted with the learner's weights" test "$policy_a" -gt 0 -a "$policy_c" -gt 0
   expect "the logger logged every episode" test "$logged_episodes" -eq $((episodes_a + episodes_c))
+  if [ "$security" = 1 ]; then
+    expect "a tampered permissions document is refused at start, naming it" \
+      grep -q "tampered-learner/permissions.p7s does not verify" "$out/tampered-learner.log"
+    for n in A B C; do
+      expect "no intruder experience or episode reached $n" \
+        test "$(grep -c "actor=99 " "$out/probe$n.txt")" -eq 0
+      expect "no thruster command reached $n" \
+        test "$(field "$out/probe$n.txt" "commands " received)" -eq 0
+      expect "the newest weights at $n are the learner's" \
+        test "$(field "$out/probe$n.txt" "weights " newest)" -eq "$newest"
+    done
+    for n in "${intruders[@]}"; do
+      expect "$n ran" test "$(field "$out/$n.txt" "intruder=" attempts)" -gt 0
+      expect "$n received nothing" test "$(field "$out/$n.txt" "intruder=" received)" -eq 0
+    done
+  fi
 elif [ "$links" = no-multicast ]; then
   expect "the actors ran" test "$sent_a" -gt 0 -a "$sent_c" -gt 0
   expect "no experience crossed to the learner" test "$received" -eq 0

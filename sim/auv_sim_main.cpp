@@ -58,6 +58,7 @@ int main(int argc, char** argv) {
   cmd.option("realtime-factor", &server.realtime_factor, "real-time mode: sim seconds per second");
   cmd.option("heartbeat-period", &server.heartbeat_period_s, "heartbeat period, s");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "simulator";
   transport::LockstepBusOptions lockstep_bus;
   transport::add_lockstep_options(cmd, lockstep_bus);
   cmd.option("open-loop", &open_loop_in, "open-loop tool: input CSV t,f1..fN (N)");

@@ -3,6 +3,7 @@
 // namespace until SIGTERM/SIGINT, then prints one line per figure (key=value, easy to grep):
 //   probe=A weights received=N versions=V newest=W bytes=B
 //   probe=A summaries received=N newest=W
+//   probe=A commands received=N          (SIM_CMD_ on the system's bus: only an intruder's)
 //   probe=A experience actor=0 batches=N transitions=T seq_gaps=G
 //   probe=A episodes actor=0 count=N steps=S policy_first=P policy_last=Q
 //   probe=A learner stats=N updates=U transitions_received=T buffer=B weights_published=W
@@ -58,6 +59,7 @@ struct Counts {
   std::map<int, ExperienceCount> experience;
   std::map<int, EpisodeCount> episodes;
   std::int64_t stats_received = 0;
+  std::int64_t commands = 0;  ///< thruster commands on the system's bus (an intruder's)
   std::optional<auvrl_lcm::learner_stats_t> last_stats;
 };
 
@@ -107,6 +109,9 @@ void subscribe_all(transport::Transport& t, Counts& c) {
         c.last_stats = s;
       },
       nullptr, kQueue);
+  // The lockstep pairs talk on domains of their own: a command here came from elsewhere.
+  t.subscribe(
+      channels::kSimCommandPattern, [&c](const transport::RawMessage&) { ++c.commands; }, kQueue);
 }
 
 /// Writes the figures, one line each (see the file comment).
@@ -115,6 +120,7 @@ void report(std::ostream& out, const std::string& label, const Counts& c) {
   out << p << "weights received=" << c.weights << " versions=" << c.weight_versions.size()
       << " newest=" << (c.weight_versions.empty() ? -1 : *c.weight_versions.rbegin())
       << " bytes=" << c.weights_bytes << "\n";
+  out << p << "commands received=" << c.commands << "\n";
   out << p << "summaries received=" << c.summaries << " newest=" << c.summary_newest << "\n";
   for (const auto& [id, e] : c.experience) {
     out << p << "experience actor=" << id << " batches=" << e.batches
@@ -148,6 +154,7 @@ int main(int argc, char** argv) {
     cmd.option("label", &label, "name printed on every line (the namespace)");
     cmd.option("out", &out_path, "write the figures here instead of stdout");
     transport::add_transport_options(cmd, config);
+  config.dds.role = "observer";
     if (!cmd.parse(argc, argv)) return 0;
     signals::install_stop_handlers();
     auto t = transport::make_transport(config);

@@ -53,32 +53,47 @@ bool handle_until(transport::Transport& t, Done done, std::chrono::milliseconds 
   return done();
 }
 
-TEST(DdsTransport, ClassesOfARegex) {
+/// The names of the topics a subscription to regex reads.
+std::vector<std::string> topics_of(const std::string& regex) {
+  std::vector<std::string> names;
+  for (int t : transport::topics_possibly_matching(regex)) {
+    names.push_back(channels::kDdsTopics[t].name);
+  }
+  return names;
+}
+
+TEST(DdsTransport, TopicsOfARegex) {
   using channels::ChannelClass;
-  using transport::classes_possibly_matching;
-  using V = std::vector<ChannelClass>;
-  EXPECT_EQ(classes_possibly_matching(".*"), (V{ChannelClass::kState, ChannelClass::kQueue,
-                                                ChannelClass::kLockstep, ChannelClass::kOther}));
-  EXPECT_EQ(classes_possibly_matching(channels::kSimCommandPattern), V{ChannelClass::kLockstep});
-  EXPECT_EQ(classes_possibly_matching(channels::sim_state(3)), V{ChannelClass::kLockstep});
-  EXPECT_EQ(classes_possibly_matching(channels::kPolicyWeights), V{ChannelClass::kState});
-  EXPECT_EQ(classes_possibly_matching(channels::kExperience), V{ChannelClass::kQueue});
-  EXPECT_EQ(classes_possibly_matching(channels::kLearnerStats), V{ChannelClass::kOther});
-  // SIM_HEARTBEAT is kOther, SIM_CMD_ kLockstep.
-  EXPECT_EQ(classes_possibly_matching("SIM_.*"),
-            (V{ChannelClass::kLockstep, ChannelClass::kOther}));
-  // An optional character shortens the literal prefix; an alternation gives everything.
-  EXPECT_EQ(classes_possibly_matching("POLICY_WEIGHTS?").size(), 1u);
-  EXPECT_EQ(classes_possibly_matching("EXPERIENCE|LEARNER_STATS"),
-            (V{ChannelClass::kQueue, ChannelClass::kOther}));
-  EXPECT_EQ(classes_possibly_matching("(POLICY_WEIGHTS|SIM_HEARTBEAT)"),
-            (V{ChannelClass::kState, ChannelClass::kOther}));
-  EXPECT_EQ(classes_possibly_matching("(EPISODE)|(SIM_STATE_[0-9]+)"),
-            (V{ChannelClass::kQueue, ChannelClass::kLockstep}));
-  EXPECT_EQ(classes_possibly_matching("EPISODE|[|]"),
-            (V{ChannelClass::kState, ChannelClass::kQueue, ChannelClass::kLockstep,
-               ChannelClass::kOther}));
-  EXPECT_EQ(classes_possibly_matching("SIM_(CMD|STATE)_1").size(), 4u) << "nested: everything";
+  using V = std::vector<std::string>;
+  EXPECT_EQ(topics_of(".*").size(), static_cast<std::size_t>(channels::kDdsTopicCount));
+  EXPECT_EQ(topics_of(channels::kSimCommandPattern), V{"auvrl_sim_command"});
+  EXPECT_EQ(topics_of(channels::sim_state(3)), V{"auvrl_sim_state"});
+  EXPECT_EQ(topics_of(channels::kPolicyWeights), V{"auvrl_weights"});
+  EXPECT_EQ(topics_of(channels::kExperience), V{"auvrl_experience"});
+  EXPECT_EQ(topics_of(channels::kLearnerStats), V{"auvrl_learner_stats"});
+  EXPECT_EQ(topics_of(channels::kMissionStatus), V{"auvrl_mission_status"});
+  EXPECT_EQ(topics_of(channels::mission(2)), V{"auvrl_mission"});
+  // The families of SIM_ and the topic of channels of no family.
+  EXPECT_EQ(topics_of("SIM_.*"), (V{"auvrl_sim_command", "auvrl_sim_reset", "auvrl_sim_state",
+                                    "auvrl_sim_event", "auvrl_heartbeat", "auvrl_other"}));
+  EXPECT_EQ(topics_of("MY_CHANNEL"), V{"auvrl_other"});
+  // An optional character shortens the literal prefix; an alternation gives each branch's.
+  EXPECT_EQ(topics_of("POLICY_WEIGHTS?"), V{"auvrl_weights"});
+  EXPECT_EQ(topics_of("EXPERIENCE|LEARNER_STATS"), (V{"auvrl_experience", "auvrl_learner_stats"}));
+  EXPECT_EQ(topics_of("(POLICY_WEIGHTS|SIM_HEARTBEAT)"), (V{"auvrl_weights", "auvrl_heartbeat"}));
+  EXPECT_EQ(topics_of("(EPISODE)|(SIM_STATE_[0-9]+)"), (V{"auvrl_experience", "auvrl_sim_state"}));
+  EXPECT_EQ(topics_of("EPISODE|[|]").size(), static_cast<std::size_t>(channels::kDdsTopicCount));
+  EXPECT_EQ(topics_of("SIM_(CMD|STATE)_1").size(),
+            static_cast<std::size_t>(channels::kDdsTopicCount))
+      << "nested: everything";
+  // Every channel of the system is on a topic of its family (none on auvrl_other).
+  for (const std::string& c :
+       {channels::kPolicySummary, channels::kEpisode, channels::kWeightsRequest,
+        channels::sim_reset(1), channels::sim_fault(1), channels::sim_current(1),
+        channels::kSimHeartbeat, channels::kLoggerHeartbeat}) {
+    EXPECT_NE(channels::dds_topic_of(c), channels::kOtherDdsTopic) << c;
+    EXPECT_EQ(topics_of(c).size(), 1u) << c;
+  }
   EXPECT_EQ(channels::channel_class(channels::kPolicySummary), ChannelClass::kState);
   EXPECT_EQ(channels::channel_class(channels::kWeightsRequest), ChannelClass::kQueue);
   EXPECT_EQ(channels::channel_class(channels::sim_fault(12)), ChannelClass::kLockstep);
