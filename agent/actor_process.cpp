@@ -87,13 +87,14 @@ namespace {
 void wait_for_system(transport::Transport& transport, const ActorProcessOptions& options,
                      int actor_id, std::ostream& log) {
   if (options.wait_for_readers.empty()) return;
-  const auto timeout = std::chrono::milliseconds(static_cast<int>(options.wait_for_readers_s * 1e3));
+  const auto timeout =
+      std::chrono::milliseconds(static_cast<int>(options.wait_for_readers_s * 1e3));
   const auto start = std::chrono::steady_clock::now();
   std::vector<std::string> missing =
       transport.wait_for_readers(channels::kExperience, options.wait_for_readers, timeout);
-  const bool wants_learner = std::find(options.wait_for_readers.begin(),
-                                       options.wait_for_readers.end(),
-                                       "learner") != options.wait_for_readers.end();
+  const bool wants_learner =
+      std::find(options.wait_for_readers.begin(), options.wait_for_readers.end(), "learner") !=
+      options.wait_for_readers.end();
   if (missing.empty() && wants_learner) {
     const auto left = timeout - (std::chrono::steady_clock::now() - start);
     missing = transport.wait_for_readers(

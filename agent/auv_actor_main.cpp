@@ -45,9 +45,13 @@ int main(int argc, char** argv) {
   add_reproducible_options(cmd, &config.reproducible, &config.round_weights_every_steps);
   cmd.custom_option(
       "wait-for-readers",
-      [&options](const std::string& v) { options.wait_for_readers = transport::parse_comma_list(v, "role"); },
-      "", "before the first episode, wait for readers of these roles (learner,logger; DDS "
-      "discovery), so that no first message is lost", "list");
+      [&options](const std::string& v) {
+        options.wait_for_readers = transport::parse_comma_list(v, "role");
+      },
+      "",
+      "before the first episode, wait for readers of these roles (learner,logger; DDS "
+      "discovery), so that no first message is lost",
+      "list");
   cmd.option("wait-for-readers-s", &options.wait_for_readers_s,
              "wait at most this long for them, then start anyway");
   cmd.option("vehicle", &options.vehicle_path,

@@ -74,18 +74,18 @@ struct DdsTopic {
 
 /// The topics (index = the topic's number; the last one takes every channel of no family).
 inline constexpr DdsTopic kDdsTopics[] = {
-    {"auvrl_weights", ChannelClass::kState},         // 0: POLICY_WEIGHTS, POLICY_SUMMARY
-    {"auvrl_experience", ChannelClass::kQueue},      // 1: EXPERIENCE, EPISODE
-    {"auvrl_weights_request", ChannelClass::kQueue}, // 2: WEIGHTS_REQUEST
-    {"auvrl_sim_command", ChannelClass::kLockstep},  // 3: SIM_CMD_
-    {"auvrl_sim_reset", ChannelClass::kLockstep},    // 4: SIM_RESET_
-    {"auvrl_sim_state", ChannelClass::kLockstep},    // 5: SIM_STATE_
-    {"auvrl_sim_event", ChannelClass::kLockstep},    // 6: SIM_FAULT_, SIM_CURRENT_
-    {"auvrl_learner_stats", ChannelClass::kOther},   // 7: LEARNER_STATS
-    {"auvrl_heartbeat", ChannelClass::kOther},       // 8: SIM_HEARTBEAT, LOGGER_HEARTBEAT
-    {"auvrl_mission", ChannelClass::kOther},         // 9: MISSION_
-    {"auvrl_mission_status", ChannelClass::kOther},  // 10: MISSION_STATUS
-    {"auvrl_other", ChannelClass::kOther},           // 11: anything else
+    {"auvrl_weights", ChannelClass::kState},          // 0: POLICY_WEIGHTS, POLICY_SUMMARY
+    {"auvrl_experience", ChannelClass::kQueue},       // 1: EXPERIENCE, EPISODE
+    {"auvrl_weights_request", ChannelClass::kQueue},  // 2: WEIGHTS_REQUEST
+    {"auvrl_sim_command", ChannelClass::kLockstep},   // 3: SIM_CMD_
+    {"auvrl_sim_reset", ChannelClass::kLockstep},     // 4: SIM_RESET_
+    {"auvrl_sim_state", ChannelClass::kLockstep},     // 5: SIM_STATE_
+    {"auvrl_sim_event", ChannelClass::kLockstep},     // 6: SIM_FAULT_, SIM_CURRENT_
+    {"auvrl_learner_stats", ChannelClass::kOther},    // 7: LEARNER_STATS
+    {"auvrl_heartbeat", ChannelClass::kOther},        // 8: SIM_HEARTBEAT, LOGGER_HEARTBEAT
+    {"auvrl_mission", ChannelClass::kOther},          // 9: MISSION_
+    {"auvrl_mission_status", ChannelClass::kOther},   // 10: MISSION_STATUS
+    {"auvrl_other", ChannelClass::kOther},            // 11: anything else
 };
 inline constexpr int kDdsTopicCount = static_cast<int>(std::size(kDdsTopics));
 /// The topic of channels of no family.
@@ -99,9 +99,9 @@ struct ChannelFamily {
 
 /// The channel families, by prefix (first match wins; no match: kOtherDdsTopic).
 inline constexpr ChannelFamily kChannelFamilies[] = {
-    {"POLICY_", 0},  {"EXPERIENCE", 1},    {"EPISODE", 1},        {"WEIGHTS_REQUEST", 2},
-    {"SIM_CMD_", 3}, {"SIM_RESET_", 4},    {"SIM_STATE_", 5},     {"SIM_FAULT_", 6},
-    {"SIM_CURRENT_", 6}, {"LEARNER_STATS", 7}, {"SIM_HEARTBEAT", 8}, {"LOGGER_HEARTBEAT", 8},
+    {"POLICY_", 0},         {"EXPERIENCE", 1},    {"EPISODE", 1},       {"WEIGHTS_REQUEST", 2},
+    {"SIM_CMD_", 3},        {"SIM_RESET_", 4},    {"SIM_STATE_", 5},    {"SIM_FAULT_", 6},
+    {"SIM_CURRENT_", 6},    {"LEARNER_STATS", 7}, {"SIM_HEARTBEAT", 8}, {"LOGGER_HEARTBEAT", 8},
     {"MISSION_STATUS", 10}, {"MISSION_", 9},
 };
 

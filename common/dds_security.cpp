@@ -49,7 +49,10 @@ std::vector<DdsRole> make_roles() {
        "auv_actor: publishes experience and episode reports, drives its simulator",
        {experience, request, command, reset},
        {weights, state}},
-      {"simulator", "auv_sim: publishes vehicle states", {state, heartbeat}, {command, reset, event}},
+      {"simulator",
+       "auv_sim: publishes vehicle states",
+       {state, heartbeat},
+       {command, reset, event}},
       {"controller",
        "auv_controller: publishes thruster commands on a vehicle",
        {command, status},
@@ -59,7 +62,9 @@ std::vector<DdsRole> make_roles() {
        "auvrl run, a person: missions, resets, faults and currents; reads everything",
        {reset, event, mission},
        all_topics()},
-      {"observer", "the launcher, probes, monitors: reads everything, publishes nothing", {},
+      {"observer",
+       "the launcher, probes, monitors: reads everything, publishes nothing",
+       {},
        all_topics()},
   };
 }
@@ -116,9 +121,9 @@ void check_certificate(const DdsSecurityFiles& f) {
     throw TransportError("DDS Security: cannot check " + f.certificate + openssl_error());
   }
   if (X509_verify_cert(ctx.get()) != 1) {
-    throw TransportError(
-        "DDS Security: the certificate " + f.certificate + " is refused by the identity CA " +
-        f.identity_ca + ": " + X509_verify_cert_error_string(X509_STORE_CTX_get_error(ctx.get())));
+    throw TransportError("DDS Security: the certificate " + f.certificate +
+                         " is refused by the identity CA " + f.identity_ca + ": " +
+                         X509_verify_cert_error_string(X509_STORE_CTX_get_error(ctx.get())));
   }
   Bio key_bio = open_bio(f.private_key);
   std::unique_ptr<EVP_PKEY, decltype(&EVP_PKEY_free)> key(
@@ -146,10 +151,9 @@ void check_signed_document(const std::string& path, const std::string& ca_path) 
   Store store = store_of(ca_path);
   Bio out(BIO_new(BIO_s_mem()), BIO_free);
   if (CMS_verify(cms.get(), nullptr, store.get(), content.get(), out.get(), CMS_TEXT) != 1) {
-    throw TransportError("DDS Security: the signature of " + path +
-                         " does not verify against the permissions CA " + ca_path +
-                         " (the document was altered, or signed by another authority)" +
-                         openssl_error());
+    throw TransportError(
+        "DDS Security: the signature of " + path + " does not verify against the permissions CA " +
+        ca_path + " (the document was altered, or signed by another authority)" + openssl_error());
   }
 }
 
@@ -210,9 +214,10 @@ std::string dds_permissions_xml(const DdsRole& role, const std::vector<std::stri
     if (subject.find_first_of("<>&\"'") != std::string::npos) {
       throw TransportError("DDS Security: the subject '" + subject + "' has XML characters");
     }
-    std::string rule = fmt::format("<domains><id_range><min>0</min><max>{}</max></id_range></domains>",
-                                   kSecuredMaxDomainId);
-    if (!role.publish.empty()) rule += "<publish><topics>" + topic_list(role.publish) + "</topics></publish>";
+    std::string rule = fmt::format(
+        "<domains><id_range><min>0</min><max>{}</max></id_range></domains>", kSecuredMaxDomainId);
+    if (!role.publish.empty())
+      rule += "<publish><topics>" + topic_list(role.publish) + "</topics></publish>";
     if (!role.subscribe.empty()) {
       rule += "<subscribe><topics>" + topic_list(role.subscribe) + "</topics></subscribe>";
     }
@@ -235,10 +240,10 @@ DdsSecurityFiles resolve_dds_security(const std::string& dir, const std::string&
     if (identity.empty() || !fs::exists(base / identity / "cert.pem")) {
       throw TransportError("DDS Security: " + dir +
                            " is neither a participant's directory (no cert.pem) nor holds one " +
-                           (identity.empty() ? std::string("(name the participant: --dds-identity)")
-                                             : "for participant '" + identity + "' (" +
-                                                   (base / identity / "cert.pem").string() +
-                                                   " is missing)"));
+                           (identity.empty()
+                                ? std::string("(name the participant: --dds-identity)")
+                                : "for participant '" + identity + "' (" +
+                                      (base / identity / "cert.pem").string() + " is missing)"));
     }
     base /= identity;
   }

@@ -3,12 +3,12 @@
 // or Cyclone DDS (common/transport_dds.hpp), chosen by TransportConfig::kind.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
-#include <chrono>
 #include <string>
 #include <utility>
 #include <vector>

@@ -153,8 +153,8 @@ class DdsTransport final : public Transport {
         if (topic == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) continue;
         Qos qos;
         set_qos(qos, channels::kDdsTopics[t].channel_class, lockstep_reliable_, -1);
-        const dds_entity_t writer = dds_create_writer(participant_, check(topic, "create a topic"),
-                                                      qos.get(), nullptr);
+        const dds_entity_t writer =
+            dds_create_writer(participant_, check(topic, "create a topic"), qos.get(), nullptr);
         if (writer == DDS_RETCODE_NOT_ALLOWED_BY_SECURITY) continue;
         writers_[t] = check(writer, "create a writer");
       }
@@ -456,7 +456,7 @@ class DdsTransport final : public Transport {
   std::string reader_tag_;
   dds_entity_t participant_ = 0;
   dds_entity_t waitset_ = 0;
-  std::array<dds_entity_t, kTopics> writers_{};   ///< per topic; 0 where not permitted
+  std::array<dds_entity_t, kTopics> writers_{};  ///< per topic; 0 where not permitted
   std::array<std::int64_t, kTopics> written_{};  ///< samples written per topic (acks at close)
   std::map<SubscriptionId, std::unique_ptr<Subscription>> subscriptions_;
   std::vector<std::pair<SubscriptionId, dds_entity_t>> readers_;
@@ -616,8 +616,7 @@ std::string dds_default_config_xml(const DdsSettings& s) {
   xml += "<AllowMulticast>false</AllowMulticast></General><Discovery><Peers>";
   for (const std::string& peer : s.peers) xml += R"(<Peer address=")" + peer + R"("/>)";
   xml += "</Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
-         std::to_string(s.max_auto_participant_index) +
-         "</MaxAutoParticipantIndex></Discovery>";
+         std::to_string(s.max_auto_participant_index) + "</MaxAutoParticipantIndex></Discovery>";
   if (!s.security_dir.empty()) {
     xml += dds_security_config_xml(resolve_dds_security(s.security_dir, s.security_identity));
   }
@@ -627,8 +626,8 @@ std::string dds_default_config_xml(const DdsSettings& s) {
 std::unique_ptr<Transport> make_dds_transport(const DdsSettings& settings, bool allow_off_host) {
   check_dds_settings(settings, allow_off_host);
   if (!settings.security_dir.empty()) {
-    check_dds_security_files(resolve_dds_security(settings.security_dir,
-                                                  settings.security_identity));
+    check_dds_security_files(
+        resolve_dds_security(settings.security_dir, settings.security_identity));
   }
   const std::string config = settings.config_path.empty() ? dds_default_config_xml(settings)
                                                           : "file://" + settings.config_path;

@@ -14,8 +14,8 @@ std::vector<std::string> parse_comma_list(const std::string& text, const std::st
     const std::string item =
         text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
     if (item.empty()) {
-      throw TransportError("empty item in the " + what + " list '" + text + "' (expected " +
-                           what + "[," + what + "...])");
+      throw TransportError("empty item in the " + what + " list '" + text + "' (expected " + what +
+                           "[," + what + "...])");
     }
     items.push_back(item);
     if (comma == std::string::npos) return items;
@@ -231,8 +231,8 @@ void read_transport_section(config::Section s, TransportConfig& config) {
   } catch (const TransportError& e) {
     s.fail(s.has("dds_config")     ? "dds_config"
            : s.has("dds_security") ? "dds_security"
-           : s.has("dds_peers") ? "dds_peers"
-                                : "kind",
+           : s.has("dds_peers")    ? "dds_peers"
+                                   : "kind",
            e.what());
   }
 }

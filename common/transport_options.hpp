@@ -1,7 +1,7 @@
 // The transport's configuration as every process and the launcher take it: the same command-
 // line flags everywhere (--transport lcm|dds, --lcm-url, --dds-domain, --dds-peers,
-// --dds-config, --dds-security, --allow-off-host), the `transport:` section of a run configuration, the flags
-// that pass a configuration on to a child process, and the private lockstep bus of a
+// --dds-config, --dds-security, --allow-off-host), the `transport:` section of a run configuration,
+// the flags that pass a configuration on to a child process, and the private lockstep bus of a
 // simulator/actor pair.
 #pragma once
 

@@ -396,8 +396,9 @@ int run_dds_policy(int argc, const char* const* argv) {
       "Prints a DDS Security document, unsigned (scripts/pki.sh signs it): `governance`, or "
       "`permissions --role ROLE --subject S...` (one grant per subject) or `roles`.");
   cli.positionals("document", &documents, "governance, permissions or roles");
-  cli.option("role", &role, "permissions: the role (learner, actor, simulator, controller, "
-                            "logger, operator, observer)");
+  cli.option("role", &role,
+             "permissions: the role (learner, actor, simulator, controller, "
+             "logger, operator, observer)");
   cli.repeatable("subject", &subjects,
                  "permissions: a participant's certificate subject, e.g. CN=actor-0,O=auvrl "
                  "(repeat the flag for each)");

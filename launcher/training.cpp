@@ -18,10 +18,10 @@
 #include <stdexcept>
 
 #include "common/channels.hpp"
+#include "common/dds_security.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
-#include "common/dds_security.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "launcher/format.hpp"
@@ -178,10 +178,10 @@ RoleSpec actor_role(const RunContext& ctx, int i, int cpu, const std::string& bi
   const std::uint64_t seed = ctx.rc.run.seed * 1000 + static_cast<std::uint64_t>(i);
   const std::uint64_t restart_seed_step = ctx.rc.run.reproducible ? 0 : 7919;
   // Its first episode waits until the learner and the logger read its experience (DDS).
-  const std::vector<std::string> rest = concat(
-      concat(reproducible_args(ctx), concat(lockstep_args(ctx, i), transport_args)),
-      concat(identity_args(ctx, "actor-" + std::to_string(i)),
-             {"--wait-for-readers", "learner,logger"}));
+  const std::vector<std::string> rest =
+      concat(concat(reproducible_args(ctx), lockstep_args(ctx, i)),
+             concat({"--wait-for-readers", "learner,logger"},
+                    concat(transport_args, identity_args(ctx, "actor-" + std::to_string(i)))));
   const std::string config_path = ctx.config_path;
   RoleSpec role = fixed_role(ctx, "actor" + std::to_string(i), RoleKind::kActor, {});
   role.actor_id = i;

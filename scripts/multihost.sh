@@ -25,7 +25,7 @@
 #   that arrive over its link, with nftables (numgen random), because this kernel has no netem
 #   ("tc qdisc add dev eth0 root netem loss 5%" -> "Error: Specified qdisc kind is unknown.").
 #   Only traffic from the other namespaces is dropped; the namespace's own looped-back
-#   multicast is not. Loss starts 2 s into the run (after discovery, see below).
+#   multicast is not. Loss starts with the run, discovery included.
 # --check: exit 1 unless the run delivered what the transport promises (DDS: every transition
 #   sent reached the learner, the newest weights reached both actor namespaces, episodes and
 #   updates happened, the logger logged every episode; LCM with --links no-multicast: nothing
@@ -258,6 +258,13 @@ stop() {  # stop NAME...: SIGTERM, then wait up to 10 s (SIGKILL after)
   done
 }
 
+# Loss from the start, discovery included: DDS delivers reliably only to the readers a writer
+# has discovered (volatile durability), so each actor waits for the learner's and the logger's
+# readers before its first episode (--wait-for-readers).
+if [ "$loss" != 0 ]; then
+  add_loss
+  log "loss on from the start"
+fi
 if [ "$security" = 1 ]; then
   # A tampered permissions document (the learner's, granting what it did not) is refused at
   # start, naming the file.
@@ -313,20 +320,8 @@ if [ "$security" = 1 ]; then
   done
 fi
 log "$transport: training for ${seconds} s (logs in $out)"
-# Loss starts after a lossless warm-up: DDS delivers reliably to the readers it has discovered
-# (volatile durability), and an actor's first episode report, ~10-50 ms after it starts, can
-# beat the discovery of a reader across a lossy link (seen once in five runs: the logger
-# missed an actor's first episode). Discovery under loss is not what this measures.
-warmup=0
-if [ "$loss" != 0 ]; then
-  warmup=2
-  sleep "$warmup" &
-  wait $!  # (a signal's trap runs at once)
-  add_loss
-  log "loss on after ${warmup} s"
-fi
-sleep $((seconds - warmup)) &
-wait $!
+sleep "$seconds" &
+wait $!  # (a signal's trap runs at once)
 # Actors first (over DDS an exiting process waits until its experience is acknowledged), then
 # time for the learner's next figures (once a second) to arrive; then the learner (over DDS it
 # waits until its newest weights are acknowledged), and the probes write what they counted.

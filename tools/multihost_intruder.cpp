@@ -109,8 +109,9 @@ void subscribe_to_system(transport::Transport& t, Tally& tally) {
         nullptr, kQueue);
   });
   guarded([&] {
-    t.subscribe("POLICY_SUMMARY|WEIGHTS_REQUEST|LEARNER_STATS|SIM_HEARTBEAT|LOGGER_HEARTBEAT",
-                [&tally](const transport::RawMessage&) { ++tally.received; }, kQueue);
+    t.subscribe(
+        "POLICY_SUMMARY|WEIGHTS_REQUEST|LEARNER_STATS|SIM_HEARTBEAT|LOGGER_HEARTBEAT",
+        [&tally](const transport::RawMessage&) { ++tally.received; }, kQueue);
   });
 }
 
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
     cmd.option("label", &label, "name printed on the line");
     cmd.option("out", &out_path, "write the line here instead of stdout");
     transport::add_transport_options(cmd, config);
-  config.dds.role = "intruder";
+    config.dds.role = "intruder";
     if (!cmd.parse(argc, argv)) return 0;
     signals::install_stop_handlers();
     auto t = transport::make_transport(config);

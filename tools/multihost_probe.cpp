@@ -154,7 +154,7 @@ int main(int argc, char** argv) {
     cmd.option("label", &label, "name printed on every line (the namespace)");
     cmd.option("out", &out_path, "write the figures here instead of stdout");
     transport::add_transport_options(cmd, config);
-  config.dds.role = "observer";
+    config.dds.role = "observer";
     if (!cmd.parse(argc, argv)) return 0;
     signals::install_stop_handlers();
     auto t = transport::make_transport(config);

@@ -9,6 +9,7 @@
 //   dds_peer publish CHANNEL N SIZE    publishes N messages of SIZE bytes (version 1..N in the
 //                                      first 8 bytes), then stays until SIGTERM (a transient-
 //                                      local writer's history lives as long as its process)
+//   dds_peer --dds-security DIR ...    the same as a secured participant (DDS Security)
 #include <chrono>
 #include <cstdint>
 #include <cstring>
@@ -103,6 +104,8 @@ void declare_modes(cli::CommandLine& cmd, Args& a) {
 int main(int argc, char** argv) {
   cli::CommandLine cmd("dds_peer", "A second process for the DDS transport tests.");
   Args args;
+  std::string security_dir;
+  cmd.option("dds-security", &security_dir, "a participant's DDS Security directory");
   declare_modes(cmd, args);
   try {
     if (!cmd.parse(argc, argv)) return 0;
@@ -114,6 +117,7 @@ int main(int argc, char** argv) {
     signals::install_stop_handlers();
     transport::TransportConfig config;
     config.kind = transport::TransportKind::kDds;
+    config.dds.security_dir = security_dir;
     auto t = transport::make_transport(config);
     const std::string mode = cmd.chosen();
     if (mode == "echo") return run_echo(*t, args);

@@ -7,6 +7,7 @@
 
 #include "child_process.hpp"
 #include "common/cli.hpp"
+#include "common/transport_dds.hpp"
 #include "common/transport_options.hpp"
 
 namespace {
@@ -72,6 +73,32 @@ TEST(TransportOptions, ArgumentsReproduceTheConfiguration) {
   EXPECT_EQ(transport::transport_arguments(dds),
             (std::vector<std::string>{"--transport", "dds", "--dds-domain", "9", "--dds-config",
                                       "/etc/cyclone.xml", "--allow-off-host"}));
+}
+
+TEST(TransportOptions, SecurityIsPassedOnAndChecked) {
+  TransportConfig config;
+  std::vector<std::string> given;
+  cli::CommandLine cmd("prog", "");
+  transport::add_transport_options(cmd, config, &given);
+  ASSERT_TRUE(parse(cmd, {"--transport", "dds", "--dds-security", "/pki", "--dds-identity",
+                          "actor-1", "--dds-peers", "10.0.0.2"}));
+  EXPECT_EQ(config.dds.security_dir, "/pki");
+  EXPECT_EQ(config.dds.security_identity, "actor-1");
+  EXPECT_EQ(transport::transport_arguments(config),
+            (std::vector<std::string>{"--transport", "dds", "--dds-domain", "0", "--dds-peers",
+                                      "10.0.0.2", "--dds-security", "/pki", "--dds-identity",
+                                      "actor-1"}));
+  // Secured, a peer off this host needs no opt-out; a domain past the governance's 230 and a
+  // Cyclone file of one's own are refused.
+  EXPECT_NO_THROW(transport::check_dds_settings(config.dds, false));
+  config.dds.domain_id = 231;
+  EXPECT_THROW(transport::check_dds_settings(config.dds, false), transport::TransportError);
+  config.dds.domain_id = 0;
+  config.dds.config_path = "/etc/hosts";
+  EXPECT_THROW(transport::check_dds_settings(config.dds, true), transport::TransportError);
+  config.dds.config_path.clear();
+  config.dds.security_dir.clear();
+  EXPECT_THROW(transport::check_dds_settings(config.dds, false), transport::TransportError);
 }
 
 TEST(TransportOptions, LockstepBusIsAPortOrADomainOfItsOwn) {

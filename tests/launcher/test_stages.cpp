@@ -137,6 +137,25 @@ TEST_F(RolesTest, StartOrderKindsAndLogs) {
   }
 }
 
+TEST_F(RolesTest, SecuredRunsGiveEachProcessItsIdentity) {
+  ctx.rc.transport.kind = transport::TransportKind::kDds;
+  ctx.rc.transport.dds.security_dir = "/pki";
+  const auto roles = make_roles(ctx, {"--transport", "dds", "--dds-security", "/pki"});
+  const std::vector<std::pair<std::string, std::string>> expected = {
+      {"logger", "logger"},   {"sim0", "sim-0"},     {"sim1", "sim-1"},
+      {"learner", "learner"}, {"actor0", "actor-0"}, {"actor1", "actor-1"}};
+  for (const auto& [role, identity] : expected) {
+    EXPECT_TRUE(has(find(roles, role).argv(0), {"--dds-identity", identity})) << role;
+  }
+  EXPECT_TRUE(has(find(roles, "actor0").argv(0), {"--wait-for-readers", "learner,logger"}));
+  // Unsecured, no identity.
+  ctx.rc.transport.dds.security_dir.clear();
+  for (const auto& r : make_roles(ctx, {"--transport", "dds"})) {
+    const auto argv = r.argv(0);
+    EXPECT_EQ(std::find(argv.begin(), argv.end(), "--dds-identity"), argv.end()) << r.name;
+  }
+}
+
 TEST_F(RolesTest, SimulatorsAndActorsShareACpuAndAPrivateBus) {
   ctx.rc.run.learner_cpu = 0;
   const auto roles = make_roles(ctx, {});
