@@ -34,6 +34,8 @@ namespace {
 
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
+// The learner's sizes for its default vehicle (Nessie VII, 6 thrusters) and the extended
+// layout (--layout extended): 17 + 6 inputs.
 constexpr int kStateDim = 23;
 constexpr int kActionDim = 6;
 
@@ -106,10 +108,8 @@ std::vector<pid_t> start_subscribers(const transport::TransportConfig& config,
 std::vector<std::string> learner_arguments(const transport::TransportConfig& config,
                                            const std::string& hidden) {
   std::vector<std::string> learner_argv = {test_support::bin_path("auv_learner"),
-                                           "--state-dim",
-                                           std::to_string(kStateDim),
-                                           "--action-dim",
-                                           std::to_string(kActionDim),
+                                           "--layout",
+                                           "extended",
                                            "--hidden",
                                            hidden,
                                            "--batch-size",
