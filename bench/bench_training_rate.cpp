@@ -1,23 +1,35 @@
 // Environment steps per second of the training system (auv_learner, N auv_actor processes and
-// their simulators), measured from auv_sim's heartbeats over a window after a warm-up, in two
+// their simulators), measured from auv_sim's heartbeats over a window after a warm-up (2 s, and
+// until every simulator's heartbeat and the learner's statistics have come), in two
 // placements: "shared" (one auv_sim for all, everything on one bus, nothing pinned) and
 // "pinned" (what auvrl train does: one auv_sim per actor pinned to the actor's CPU, a private
 // lockstep bus per pair: an LCM port, or a DDS domain, of its own). The learner updates at the
-// given ratio, without flow control. Over LCM and over DDS in the same run (--transport).
+// given ratio, without flow control. Over LCM, DDS and DDS with DDS Security in the same run
+// (--transport: lcm, dds, dds-secure; both = lcm and dds; dds-both = dds and dds-secure; all =
+// the three, one after the other).
 // Prints: training transport=T placement=P actors=N seconds=S env_steps_per_s=X updates_per_s=Y
 // Run inside a private network namespace: scripts/netns.sh build/bin/bench_training_rate
+//
+// dds-secure needs --dds-security DIR, made by scripts/pki.sh, with an identity for each process
+// as auvrl train names them: learner, actor-I, sim-I (pinned: one per actor; shared: sim-0 for
+// all), launcher (this process, an observer: it reads heartbeats and the learner's statistics).
+// scripts/pki.sh's default (--actors 2) has them all:
+//   scripts/pki.sh --out DIR
+//   scripts/netns.sh build/bin/bench_training_rate --transport dds-both --dds-security DIR
 #include <unistd.h>
 
 #include <auvrl_lcm/learner_stats_t.hpp>
 #include <auvrl_lcm/sim_heartbeat_t.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
 
 #include "child_process.hpp"
 #include "common/channels.hpp"
 #include "common/cli.hpp"
+#include "common/dds_security.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
 
@@ -25,6 +37,29 @@ namespace {
 
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
+constexpr int kMaxActors = 2;  // the cases: 1 and 2 actors
+
+/// One transport the bench runs over: its name in the output and its configuration. A secured
+/// one (DDS Security: dds.security_dir set) gives each process an identity of its own.
+struct Variant {
+  std::string name;
+  transport::TransportConfig config;
+};
+
+/// The configuration of participant `identity` (a name in scripts/pki.sh's directory): config
+/// itself when it is not secured.
+transport::TransportConfig as_participant(const transport::TransportConfig& config,
+                                          const std::string& identity) {
+  transport::TransportConfig c = config;
+  if (!c.dds.security_dir.empty()) c.dds.security_identity = identity;
+  return c;
+}
+
+/// The transport flags of participant `identity`.
+std::vector<std::string> participant_arguments(const transport::TransportConfig& config,
+                                               const std::string& identity) {
+  return transport::transport_arguments(as_participant(config, identity));
+}
 
 /// The private lockstep bus of pair i (as auvrl train makes it).
 std::vector<std::string> lockstep_bus_args(const transport::TransportConfig& config, int i) {
@@ -35,7 +70,8 @@ std::vector<std::string> lockstep_bus_args(const transport::TransportConfig& con
           "udpm://239.255.76.67:" + std::to_string(7668 + i) + "?ttl=0&recv_buf_size=1048576"};
 }
 
-/// The command line of auv_sim number i: pinned, one vehicle on pair i's bus; shared, all.
+/// The command line of auv_sim number i (participant sim-i): pinned, one vehicle on pair i's
+/// bus; shared, all.
 std::vector<std::string> sim_arguments(const transport::TransportConfig& config, int i, int actors,
                                        bool pinned, int cpus) {
   std::vector<std::string> argv = {test_support::bin_path("auv_sim"), "--heartbeat-period", "0.25"};
@@ -47,7 +83,8 @@ std::vector<std::string> sim_arguments(const transport::TransportConfig& config,
   } else {
     argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
   }
-  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  const std::vector<std::string> transport_args =
+      participant_arguments(config, "sim-" + std::to_string(i));
   argv.insert(argv.end(), transport_args.begin(), transport_args.end());
   return argv;
 }
@@ -62,15 +99,15 @@ std::vector<std::string> learner_arguments(const transport::TransportConfig& con
                                            "64-64",
                                            "--batch-size",
                                            "256",
-                                           "--state-dim",
-                                           "23",
+                                           "--layout",
+                                           "extended",
                                            "--updates-per-transition",
                                            learner_ratio,
                                            "--warmup-transitions",
                                            "5000",
                                            "--replay-capacity",
                                            "200000"};
-  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  const std::vector<std::string> transport_args = participant_arguments(config, "learner");
   learner_argv.insert(learner_argv.end(), transport_args.begin(), transport_args.end());
   return learner_argv;
 }
@@ -94,7 +131,8 @@ std::vector<std::string> actor_arguments(const transport::TransportConfig& confi
     const auto b = lockstep_bus_args(config, id);
     argv.insert(argv.end(), b.begin(), b.end());
   }
-  const std::vector<std::string> transport_args = transport::transport_arguments(config);
+  const std::vector<std::string> transport_args =
+      participant_arguments(config, "actor-" + std::to_string(id));
   argv.insert(argv.end(), transport_args.begin(), transport_args.end());
   return argv;
 }
@@ -106,10 +144,11 @@ struct Rates {
   double updates_per_s = 0.0;
 };
 
-/// A 2 s warm-up, then environment steps (the simulators' heartbeats) and learner updates over
-/// `seconds`.
+/// A 2 s warm-up (longer until a heartbeat of each of the `sims` simulators and the learner's
+/// statistics have come: DDS discovery, and authentication when secured, take their time), then
+/// environment steps (the simulators' heartbeats) and learner updates over `seconds`.
 Rates measure(transport::Transport& monitor,
-              const std::map<int, auvrl_lcm::sim_heartbeat_t>& heartbeats,
+              const std::map<int, auvrl_lcm::sim_heartbeat_t>& heartbeats, std::size_t sims,
               transport::Latest<auvrl_lcm::learner_stats_t>& stats, double seconds) {
   const auto total_steps = [&] {
     std::int64_t n = 0;
@@ -121,6 +160,10 @@ Rates measure(transport::Transport& monitor,
     while (Clock::now() < end) monitor.handle(50);
   };
   pump(2.0);  // warm-up: processes start, the learner starts updating
+  const auto give_up = Clock::now() + std::chrono::seconds(20);
+  while ((heartbeats.size() < sims || !stats.has_value()) && Clock::now() < give_up) {
+    monitor.handle(50);
+  }
   const std::int64_t first = total_steps();
   std::optional<auvrl_lcm::learner_stats_t> first_stats = stats.take();
   const auto t0 = Clock::now();
@@ -138,10 +181,11 @@ Rates measure(transport::Transport& monitor,
 
 /// One case: the simulators, auv_learner and `actors` actors in the given placement; prints the
 /// rates measured.
-void run_case(const transport::TransportConfig& config, int actors, double seconds,
-              const std::string& learner_ratio, bool pinned) {
+void run_case(const Variant& v, int actors, double seconds, const std::string& learner_ratio,
+              bool pinned) {
+  const transport::TransportConfig& config = v.config;
   const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
-  auto monitor = transport::make_transport(config);
+  auto monitor = transport::make_transport(as_participant(config, "launcher"));
   std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *monitor, channels::kSimHeartbeat,
@@ -159,13 +203,53 @@ void run_case(const transport::TransportConfig& config, int actors, double secon
     procs.push_back(std::make_unique<test_support::ChildProcess>(
         actor_arguments(config, id, pinned, cpus), dir + "/actor" + std::to_string(id) + ".log"));
   }
-  const Rates r = measure(*monitor, heartbeats, stats, seconds);
+  const std::size_t sims = pinned ? static_cast<std::size_t>(actors) : 1;
+  const Rates r = measure(*monitor, heartbeats, sims, stats, seconds);
   std::printf(
       "training transport=%s placement=%s actors=%d seconds=%.1f env_steps_per_s=%.0f "
       "updates_per_s=%.0f updates_per_transition=%s\n",
-      transport::to_string(config.kind).c_str(), pinned ? "pinned" : "shared", actors, r.seconds,
-      r.steps_per_s, r.updates_per_s, learner_ratio.c_str());
+      v.name.c_str(), pinned ? "pinned" : "shared", actors, r.seconds, r.steps_per_s,
+      r.updates_per_s, learner_ratio.c_str());
   std::fflush(stdout);
+}
+
+/// Whether --transport `which` runs the variant `name` (lcm, dds, dds-secure; both: lcm and dds;
+/// dds-both: dds and dds-secure; all: the three).
+bool selected(const std::string& which, const std::string& name) {
+  if (which == name || which == "all") return true;
+  if (which == "both") return name == "lcm" || name == "dds";
+  return which == "dds-both" && (name == "dds" || name == "dds-secure");
+}
+
+/// The variants --transport selects, dds-secure with scripts/pki.sh's directory.
+std::vector<Variant> select_variants(const std::string& which, const std::string& security_dir) {
+  Variant lcm{"lcm", {}}, dds{"dds", {}}, secure{"dds-secure", {}};
+  dds.config.kind = secure.config.kind = transport::TransportKind::kDds;
+  secure.config.dds.security_dir = security_dir;
+  std::vector<Variant> variants;
+  for (const Variant& v : {lcm, dds, secure}) {
+    if (selected(which, v.name)) variants.push_back(v);
+  }
+  return variants;
+}
+
+/// Refuses (TransportError) a secured run whose directory lacks a valid identity for one of
+/// the processes, before anything starts.
+void check_identities(const std::string& dir) {
+  if (dir.empty()) {
+    throw transport::TransportError("--transport dds-secure needs --dds-security DIR");
+  }
+  if (std::filesystem::exists(std::filesystem::path(dir) / "cert.pem")) {
+    throw transport::TransportError(dir + " is one participant's directory, not scripts/pki.sh's");
+  }
+  std::vector<std::string> names = {"learner", "launcher"};
+  for (int i = 0; i < kMaxActors; ++i) {
+    names.push_back("actor-" + std::to_string(i));
+    names.push_back("sim-" + std::to_string(i));
+  }
+  for (const std::string& name : names) {
+    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
+  }
 }
 
 }  // namespace
@@ -178,21 +262,32 @@ int main(int argc, char** argv) {
   cmd.option("seconds", &seconds, "measuring window per case");
   cmd.option("updates-per-transition", &ratio, "the learner's update ratio");
   std::string which = "both";
-  cmd.option("transport", &which, "lcm, dds or both (one after the other, same run)");
-  cmd.choices("transport", {"lcm", "dds", "both"});
+  cmd.option("transport", &which,
+             "lcm, dds, dds-secure (DDS Security), both (lcm and dds), dds-both (dds and "
+             "dds-secure) or all (one after the other, same run)");
+  cmd.choices("transport", {"lcm", "dds", "dds-secure", "both", "dds-both", "all"});
+  std::string security_dir;
+  cmd.option("dds-security", &security_dir,
+             "dds-secure: a directory made by scripts/pki.sh with the participants learner, "
+             "launcher, actor-0, actor-1, sim-0 and sim-1 (scripts/pki.sh --out DIR)");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
     return 2;
   }
+  try {
+    if (selected(which, "dds-secure")) check_identities(security_dir);
+  } catch (const transport::TransportError& e) {
+    std::cerr << e.what() << "\n(make the PKI: scripts/pki.sh --out DIR)\n";
+    return 2;
+  }
+  const std::vector<Variant> variants = select_variants(which, security_dir);
   for (bool pinned : {false, true}) {
-    for (const std::string name : {"lcm", "dds"}) {
-      if (which != "both" && which != name) continue;
-      transport::TransportConfig config;
-      config.kind = transport::parse_transport_kind(name);
-      run_case(config, 1, seconds, ratio, pinned);
-      run_case(config, 2, seconds, ratio, pinned);
+    for (const Variant& v : variants) {
+      for (int actors = 1; actors <= kMaxActors; ++actors) {
+        run_case(v, actors, seconds, ratio, pinned);
+      }
     }
   }
   return 0;
