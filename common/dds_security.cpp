@@ -9,7 +9,10 @@
 #include <openssl/x509_vfy.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 
 #include "common/channels.hpp"
@@ -173,34 +176,58 @@ const DdsRole& dds_role(const std::string& name) {
   throw TransportError("unknown DDS Security role '" + name + "' (expected one of " + names + ")");
 }
 
-std::string dds_governance_xml() {
+namespace {
+
+/// A governance topic rule: access control on, the given protection of submessages and data.
+std::string topic_rule(const char* expression, const char* protection) {
   return fmt::format(
-      R"(<?xml version="1.0" encoding="UTF-8"?>
+      "        <topic_rule>\n"
+      "          <topic_expression>{}</topic_expression>\n"
+      "          <enable_discovery_protection>true</enable_discovery_protection>\n"
+      "          <enable_liveliness_protection>true</enable_liveliness_protection>\n"
+      "          <enable_read_access_control>true</enable_read_access_control>\n"
+      "          <enable_write_access_control>true</enable_write_access_control>\n"
+      "          <metadata_protection_kind>{}</metadata_protection_kind>\n"
+      "          <data_protection_kind>{}</data_protection_kind>\n"
+      "        </topic_rule>\n",
+      expression, protection, protection);
+}
+
+/// A governance domain rule: closed to the unauthenticated, join access control, discovery
+/// and liveliness encrypted, then the topic rules (the first that matches a topic applies).
+std::string domain_rule(const std::string& domains, const std::string& topic_rules) {
+  return fmt::format(
+      "    <domain_rule>\n"
+      "      <domains>{}</domains>\n"
+      "      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>\n"
+      "      <enable_join_access_control>true</enable_join_access_control>\n"
+      "      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>\n"
+      "      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>\n"
+      "      <rtps_protection_kind>NONE</rtps_protection_kind>\n"
+      "      <topic_access_rules>\n{}      </topic_access_rules>\n"
+      "    </domain_rule>\n",
+      domains, topic_rules);
+}
+
+}  // namespace
+
+std::string dds_governance_xml(int system_domain) {
+  if (system_domain < 0 || system_domain > kSecuredMaxDomainId) {
+    throw TransportError(fmt::format("DDS Security: the system's domain {} is out of range (0..{})",
+                                     system_domain, kSecuredMaxDomainId));
+  }
+  // The system's bus (the domain that crosses hosts): everything encrypted. Any other domain
+  // is a lockstep pair's private bus, loopback only (lockstep_bus_config): its simulator
+  // topics are authenticated and access-controlled but not encrypted, since per-message
+  // cryptography there halves the steps a pair makes and the bus never leaves its host.
+  return R"(<?xml version="1.0" encoding="UTF-8"?>
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
   <domain_access_rules>
-    <domain_rule>
-      <domains><id_range><min>0</min><max>{}</max></id_range></domains>
-      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
-      <enable_join_access_control>true</enable_join_access_control>
-      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
-      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>
-      <rtps_protection_kind>NONE</rtps_protection_kind>
-      <topic_access_rules>
-        <topic_rule>
-          <topic_expression>*</topic_expression>
-          <enable_discovery_protection>true</enable_discovery_protection>
-          <enable_liveliness_protection>true</enable_liveliness_protection>
-          <enable_read_access_control>true</enable_read_access_control>
-          <enable_write_access_control>true</enable_write_access_control>
-          <metadata_protection_kind>ENCRYPT</metadata_protection_kind>
-          <data_protection_kind>ENCRYPT</data_protection_kind>
-        </topic_rule>
-      </topic_access_rules>
-    </domain_rule>
-  </domain_access_rules>
-</dds>
-)",
-      kSecuredMaxDomainId);
+)" + domain_rule(fmt::format("<id>{}</id>", system_domain), topic_rule("*", "ENCRYPT")) +
+         domain_rule(fmt::format("<id_range><min>0</min><max>{}</max></id_range>",
+                                 kSecuredMaxDomainId),
+                     topic_rule("auvrl_sim_*", "NONE") + topic_rule("*", "ENCRYPT")) +
+         "  </domain_access_rules>\n</dds>\n";
 }
 
 std::string dds_permissions_xml(const DdsRole& role, const std::vector<std::string>& subjects,
@@ -269,6 +296,18 @@ void check_dds_security_files(const DdsSecurityFiles& f) {
   check_certificate(f);
   check_signed_document(f.governance, f.permissions_ca);
   check_signed_document(f.permissions, f.permissions_ca);
+}
+
+int dds_governance_system_domain(const std::string& governance_path) {
+  std::ifstream in(governance_path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string tag = "<domains><id>";
+  const auto at = text.find(tag);
+  if (at == std::string::npos) {
+    throw TransportError("DDS Security: " + governance_path +
+                         " names no system domain (make it with scripts/pki.sh)");
+  }
+  return std::atoi(text.c_str() + at + tag.size());
 }
 
 std::string dds_security_config_xml(const DdsSecurityFiles& f) {

@@ -38,9 +38,11 @@ const DdsRole& dds_role(const std::string& name);
 inline constexpr int kSecuredMaxDomainId = 230;
 
 /// The governance document (unsigned XML): every domain 0..kSecuredMaxDomainId closed to
-/// unauthenticated participants, join access control on, discovery, liveliness, metadata and
-/// data encrypted, read and write access control on every topic.
-std::string dds_governance_xml();
+/// unauthenticated participants, join access control on, discovery and liveliness encrypted,
+/// read and write access control on every topic; in system_domain (the bus that crosses
+/// hosts) every topic's submessages and data encrypted; in the others (the lockstep pairs'
+/// loopback-only buses) the simulator topics not encrypted, everything else encrypted.
+std::string dds_governance_xml(int system_domain);
 
 /// The permissions document (unsigned XML) of a role: one grant per subject (an X.509 subject
 /// name, "CN=actor-0,O=auvrl"), valid from not_before to not_after (YYYY-MM-DDTHH:MM:SS),
@@ -70,6 +72,10 @@ DdsSecurityFiles resolve_dds_security(const std::string& dir, const std::string&
 /// documents carry a valid signature of the permissions CA (a tampered document does not).
 /// Throws TransportError.
 void check_dds_security_files(const DdsSecurityFiles& files);
+
+/// The system domain a signed governance document (governance.p7s) was made for: its first
+/// domain rule's single id. Throws TransportError if it has none.
+int dds_governance_system_domain(const std::string& governance_path);
 
 /// The <Security> element of a Cyclone domain configuration for these files.
 std::string dds_security_config_xml(const DdsSecurityFiles& files);

@@ -62,6 +62,9 @@ struct DdsSettings {
   /// that a publisher can wait for the readers of a role (Transport::wait_for_readers). Each
   /// program sets its own.
   std::string role;
+  /// A lockstep pair's private bus (set by lockstep_bus_config): loopback only, and under DDS
+  /// Security not the governance's system domain.
+  bool private_lockstep_bus = false;
 };
 
 /// Which transport to open and how.

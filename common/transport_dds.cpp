@@ -626,8 +626,19 @@ std::string dds_default_config_xml(const DdsSettings& s) {
 std::unique_ptr<Transport> make_dds_transport(const DdsSettings& settings, bool allow_off_host) {
   check_dds_settings(settings, allow_off_host);
   if (!settings.security_dir.empty()) {
-    check_dds_security_files(
-        resolve_dds_security(settings.security_dir, settings.security_identity));
+    const DdsSecurityFiles files =
+        resolve_dds_security(settings.security_dir, settings.security_identity);
+    check_dds_security_files(files);
+    // The governance encrypts everything in its system domain only: a system bus in another
+    // domain would carry the simulator topics in clear.
+    const int system_domain = dds_governance_system_domain(files.governance);
+    if (!settings.private_lockstep_bus && settings.domain_id != system_domain) {
+      throw TransportError("DDS Security: " + files.governance + " was made for system domain " +
+                           std::to_string(system_domain) + ", but this bus is domain " +
+                           std::to_string(settings.domain_id) +
+                           " (make the PKI with scripts/pki.sh --domain " +
+                           std::to_string(settings.domain_id) + ")");
+    }
   }
   const std::string config = settings.config_path.empty() ? dds_default_config_xml(settings)
                                                           : "file://" + settings.config_path;

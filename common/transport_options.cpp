@@ -128,6 +128,11 @@ std::optional<TransportConfig> lockstep_bus_config(const TransportConfig& system
     return std::nullopt;
   }
   bus.dds.domain_id = options.dds_domain_id;
+  // The pair runs on one host: its bus never leaves it (loopback only, whatever the system's
+  // peers), so no other host can reach the simulator's commands.
+  bus.dds.peers = {"127.0.0.1"};
+  bus.dds.config_path.clear();
+  bus.dds.private_lockstep_bus = true;
   return bus;
 }
 

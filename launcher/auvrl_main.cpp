@@ -390,6 +390,7 @@ int run_verify(int argc, const char* const* argv) {
 
 int run_dds_policy(int argc, const char* const* argv) {
   std::string role, not_before = "2026-01-01T00:00:00", not_after;
+  int system_domain = 0;
   std::vector<std::string> subjects, documents;
   auvrl::cli::CommandLine cli(
       "auvrl dds-policy",
@@ -402,12 +403,14 @@ int run_dds_policy(int argc, const char* const* argv) {
   cli.repeatable("subject", &subjects,
                  "permissions: a participant's certificate subject, e.g. CN=actor-0,O=auvrl "
                  "(repeat the flag for each)");
+  cli.option("system-domain", &system_domain,
+             "governance: the system's DDS domain (the lockstep pairs' are the others)");
   cli.option("not-before", &not_before, "permissions: valid from (YYYY-MM-DDTHH:MM:SS)");
   cli.option("not-after", &not_after, "permissions: valid until (YYYY-MM-DDTHH:MM:SS)");
   if (!cli.parse(argc, argv)) return 0;
   const std::string document = documents.size() == 1 ? documents[0] : "";
   if (document == "governance") {
-    std::cout << auvrl::transport::dds_governance_xml();
+    std::cout << auvrl::transport::dds_governance_xml(system_domain);
   } else if (document == "roles") {
     for (const auto& r : auvrl::transport::dds_roles()) {
       std::cout << r.name << "\t" << r.description << "\n";

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
              "messages the source may hold between polls");
   cmd.option("report-period", &report_period_s, "a count line every this many seconds");
   transport::add_transport_options(cmd, transport_config);
+  transport_config.dds.role = "observer";  // DDS to LCM: reads, publishes nothing on DDS
   transport::TransportConfig source, destination;
   try {
     if (!cmd.parse(argc, argv)) return 0;

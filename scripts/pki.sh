@@ -5,13 +5,15 @@
 # directory and its name): `--dds-security DIR/actor-0`, or `--dds-security DIR --dds-identity
 # actor-0`; `auvrl train --transport dds --dds-security DIR` names each process itself.
 #
-#   scripts/pki.sh --out DIR [--actors N] [--controllers N] [--days D]
+#   scripts/pki.sh --out DIR [--actors N] [--controllers N] [--days D] [--domain D]
 #                  [--participant ROLE:NAME]...
 #
 # Participants: learner, logger, launcher (observer), operator, actor-I and sim-I for I < N
 # (default 2), controller-I for I < --controllers (default 1), and each --participant (roles:
 # `auvrl dds-policy roles`). The roles' grants (which topics each may publish and read) come
 # from `auvrl dds-policy` (common/dds_security.cpp), so the documents match the build.
+# --domain: the system's DDS domain (default 0; `--dds-domain` of the processes): everything
+# on it is encrypted; other domains are lockstep pairs' loopback-only buses.
 #
 # DIR/ca/ca.key           the authority's private key (mode 0600; keep it off the hosts)
 # DIR/ca/ca.pem           its certificate (identity CA and permissions CA)
@@ -23,9 +25,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${AUVRL_BIN_DIR:-$root/build/bin}
-usage() { sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 
-out="" actors=2 controllers=1 days=30
+out="" actors=2 controllers=1 days=30 domain=0
 extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -33,13 +35,14 @@ while [ $# -gt 0 ]; do
     --actors) actors=$2; shift 2 ;;
     --controllers) controllers=$2; shift 2 ;;
     --days) days=$2; shift 2 ;;
+    --domain) domain=$2; shift 2 ;;
     --participant) extra+=("$2"); shift 2 ;;
     -h|--help) usage ;;
     *) echo "pki.sh: unknown argument '$1'" >&2; usage ;;
   esac
 done
 [ -n "$out" ] || { echo "pki.sh: --out DIR is required" >&2; usage; }
-for n in "$actors" "$controllers" "$days"; do
+for n in "$actors" "$controllers" "$days" "$domain"; do
   [[ "$n" =~ ^[0-9]+$ ]] || { echo "pki.sh: expected a number, got '$n'" >&2; exit 2; }
 done
 [ -x "$bin/auvrl" ] || { echo "pki.sh: $bin/auvrl is missing (build first)" >&2; exit 1; }
@@ -72,7 +75,7 @@ openssl req -x509 -new -key "$tmp/ca/ca.key" -days "$days" -subj "/O=$run_id/CN=
 not_before=$(date -u -d '-1 hour' +%Y-%m-%dT%H:%M:%S)
 not_after=$(date -u -d "+$days days" +%Y-%m-%dT%H:%M:%S)
 
-"$bin/auvrl" dds-policy governance >"$tmp/governance.xml"
+"$bin/auvrl" dds-policy governance --system-domain "$domain" >"$tmp/governance.xml"
 sign "$tmp/governance.xml" "$tmp/governance.p7s"
 for role in $roles; do
   subjects=()

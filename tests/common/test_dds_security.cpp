@@ -50,10 +50,20 @@ TEST(DdsSecurityRoles, OnlyTheirOwnPublish) {
 }
 
 TEST(DdsSecurityDocuments, GovernanceClosesTheDomainAndPermissionsGrantPerSubject) {
-  const std::string governance = transport::dds_governance_xml();
+  const std::string governance = transport::dds_governance_xml(3);
   EXPECT_NE(governance.find("<allow_unauthenticated_participants>false<"), std::string::npos);
   EXPECT_NE(governance.find("<data_protection_kind>ENCRYPT<"), std::string::npos);
   EXPECT_NE(governance.find("<max>230</max>"), std::string::npos);
+  // The system's domain first, everything encrypted; then the lockstep buses, whose simulator
+  // topics are not.
+  const auto system_rule = governance.find("<domains><id>3</id></domains>");
+  const auto sim_rule = governance.find("<topic_expression>auvrl_sim_*</topic_expression>");
+  ASSERT_NE(system_rule, std::string::npos);
+  ASSERT_NE(sim_rule, std::string::npos);
+  EXPECT_LT(system_rule, sim_rule);
+  EXPECT_EQ(governance.find("<data_protection_kind>NONE<"),
+            governance.find("<data_protection_kind>", sim_rule));
+  EXPECT_THROW(transport::dds_governance_xml(231), transport::TransportError);
   const std::string permissions = transport::dds_permissions_xml(
       transport::dds_role("learner"), {"CN=learner,O=x", "CN=learner-2,O=x"}, "2026-01-01T00:00:00",
       "2027-01-01T00:00:00");
@@ -169,6 +179,21 @@ transport::TransportConfig secured(const std::string& pki, const std::string& na
   config.dds.security_dir = pki;
   config.dds.security_identity = name;
   return config;
+}
+
+TEST(DdsSecurityTransport, TheSystemBusMustBeTheGovernancesDomain) {
+  EXPECT_EQ(transport::dds_governance_system_domain(pkis().run + "/governance.p7s"), 0);
+  transport::TransportConfig config = secured(pkis().run, "learner");
+  config.dds.domain_id = 4;
+  try {
+    transport::make_transport(config);
+    FAIL() << "a system bus outside the governance's domain was opened";
+  } catch (const transport::TransportError& e) {
+    EXPECT_NE(std::string(e.what()).find("scripts/pki.sh --domain 4"), std::string::npos)
+        << e.what();
+  }
+  config.dds.private_lockstep_bus = true;  // a lockstep pair's bus may be any other domain
+  EXPECT_NO_THROW(transport::make_transport(config));
 }
 
 TEST(DdsSecurityTransport, ARoleCannotPublishOrReadWhatItIsNotGranted) {

@@ -109,12 +109,18 @@ TEST(TransportOptions, LockstepBusIsAPortOrADomainOfItsOwn) {
   EXPECT_EQ(lcm_bus->lcm_url, "udpm://239.255.76.67:7670?ttl=0");
   TransportConfig dds;
   dds.kind = TransportKind::kDds;
+  dds.dds.peers = {"10.0.0.1", "10.0.0.2"};
+  dds.dds.security_dir = "/pki";
   EXPECT_FALSE(transport::lockstep_bus_config(dds, {}).has_value());
   EXPECT_FALSE(transport::lockstep_bus_config(dds, {"", 0}).has_value()) << "the same domain";
   const auto dds_bus = transport::lockstep_bus_config(dds, {"", 3});
   ASSERT_TRUE(dds_bus.has_value());
   EXPECT_EQ(dds_bus->kind, TransportKind::kDds);
   EXPECT_EQ(dds_bus->dds.domain_id, 3);
+  // The pair's bus stays on its host, secured as the system's.
+  EXPECT_EQ(dds_bus->dds.peers, std::vector<std::string>{"127.0.0.1"});
+  EXPECT_TRUE(dds_bus->dds.private_lockstep_bus);
+  EXPECT_EQ(dds_bus->dds.security_dir, "/pki");
 }
 
 class TransportSection : public ::testing::Test {
