@@ -32,34 +32,13 @@
 #include "common/dds_security.hpp"
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
+#include "transport_variants.hpp"
 
 namespace {
 
 using namespace auvrl;
 using Clock = std::chrono::steady_clock;
 constexpr int kMaxActors = 2;  // the cases: 1 and 2 actors
-
-/// One transport the bench runs over: its name in the output and its configuration. A secured
-/// one (DDS Security: dds.security_dir set) gives each process an identity of its own.
-struct Variant {
-  std::string name;
-  transport::TransportConfig config;
-};
-
-/// The configuration of participant `identity` (a name in scripts/pki.sh's directory): config
-/// itself when it is not secured.
-transport::TransportConfig as_participant(const transport::TransportConfig& config,
-                                          const std::string& identity) {
-  transport::TransportConfig c = config;
-  if (!c.dds.security_dir.empty()) c.dds.security_identity = identity;
-  return c;
-}
-
-/// The transport flags of participant `identity`.
-std::vector<std::string> participant_arguments(const transport::TransportConfig& config,
-                                               const std::string& identity) {
-  return transport::transport_arguments(as_participant(config, identity));
-}
 
 /// The private lockstep bus of pair i (as auvrl train makes it).
 std::vector<std::string> lockstep_bus_args(const transport::TransportConfig& config, int i) {
@@ -84,7 +63,7 @@ std::vector<std::string> sim_arguments(const transport::TransportConfig& config,
     argv.insert(argv.end(), {"--vehicles", std::to_string(actors)});
   }
   const std::vector<std::string> transport_args =
-      participant_arguments(config, "sim-" + std::to_string(i));
+      bench::participant_arguments(config, "sim-" + std::to_string(i));
   argv.insert(argv.end(), transport_args.begin(), transport_args.end());
   return argv;
 }
@@ -107,7 +86,7 @@ std::vector<std::string> learner_arguments(const transport::TransportConfig& con
                                            "5000",
                                            "--replay-capacity",
                                            "200000"};
-  const std::vector<std::string> transport_args = participant_arguments(config, "learner");
+  const std::vector<std::string> transport_args = bench::participant_arguments(config, "learner");
   learner_argv.insert(learner_argv.end(), transport_args.begin(), transport_args.end());
   return learner_argv;
 }
@@ -132,7 +111,7 @@ std::vector<std::string> actor_arguments(const transport::TransportConfig& confi
     argv.insert(argv.end(), b.begin(), b.end());
   }
   const std::vector<std::string> transport_args =
-      participant_arguments(config, "actor-" + std::to_string(id));
+      bench::participant_arguments(config, "actor-" + std::to_string(id));
   argv.insert(argv.end(), transport_args.begin(), transport_args.end());
   return argv;
 }
@@ -181,11 +160,11 @@ Rates measure(transport::Transport& monitor,
 
 /// One case: the simulators, auv_learner and `actors` actors in the given placement; prints the
 /// rates measured.
-void run_case(const Variant& v, int actors, double seconds, const std::string& learner_ratio,
-              bool pinned) {
+void run_case(const bench::TransportVariant& v, int actors, double seconds,
+              const std::string& learner_ratio, bool pinned) {
   const transport::TransportConfig& config = v.config;
   const std::string dir = test_support::make_temp_dir("auvrl_bench_training_");
-  auto monitor = transport::make_transport(as_participant(config, "launcher"));
+  auto monitor = transport::make_transport(bench::as_participant(config, "launcher"));
   std::map<int, auvrl_lcm::sim_heartbeat_t> heartbeats;  // by sim pid
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *monitor, channels::kSimHeartbeat,
@@ -213,43 +192,14 @@ void run_case(const Variant& v, int actors, double seconds, const std::string& l
   std::fflush(stdout);
 }
 
-/// Whether --transport `which` runs the variant `name` (lcm, dds, dds-secure; both: lcm and dds;
-/// dds-both: dds and dds-secure; all: the three).
-bool selected(const std::string& which, const std::string& name) {
-  if (which == name || which == "all") return true;
-  if (which == "both") return name == "lcm" || name == "dds";
-  return which == "dds-both" && (name == "dds" || name == "dds-secure");
-}
-
-/// The variants --transport selects, dds-secure with scripts/pki.sh's directory.
-std::vector<Variant> select_variants(const std::string& which, const std::string& security_dir) {
-  Variant lcm{"lcm", {}}, dds{"dds", {}}, secure{"dds-secure", {}};
-  dds.config.kind = secure.config.kind = transport::TransportKind::kDds;
-  secure.config.dds.security_dir = security_dir;
-  std::vector<Variant> variants;
-  for (const Variant& v : {lcm, dds, secure}) {
-    if (selected(which, v.name)) variants.push_back(v);
-  }
-  return variants;
-}
-
-/// Refuses (TransportError) a secured run whose directory lacks a valid identity for one of
-/// the processes, before anything starts.
-void check_identities(const std::string& dir) {
-  if (dir.empty()) {
-    throw transport::TransportError("--transport dds-secure needs --dds-security DIR");
-  }
-  if (std::filesystem::exists(std::filesystem::path(dir) / "cert.pem")) {
-    throw transport::TransportError(dir + " is one participant's directory, not scripts/pki.sh's");
-  }
+/// The participants a secured run needs: the learner, this process, each actor and simulator.
+std::vector<std::string> participants() {
   std::vector<std::string> names = {"learner", "launcher"};
   for (int i = 0; i < kMaxActors; ++i) {
     names.push_back("actor-" + std::to_string(i));
     names.push_back("sim-" + std::to_string(i));
   }
-  for (const std::string& name : names) {
-    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
-  }
+  return names;
 }
 
 }  // namespace
@@ -262,29 +212,25 @@ int main(int argc, char** argv) {
   cmd.option("seconds", &seconds, "measuring window per case");
   cmd.option("updates-per-transition", &ratio, "the learner's update ratio");
   std::string which = "both";
-  cmd.option("transport", &which,
-             "lcm, dds, dds-secure (DDS Security), both (lcm and dds), dds-both (dds and "
-             "dds-secure) or all (one after the other, same run)");
-  cmd.choices("transport", {"lcm", "dds", "dds-secure", "both", "dds-both", "all"});
   std::string security_dir;
-  cmd.option("dds-security", &security_dir,
-             "dds-secure: a directory made by scripts/pki.sh with the participants learner, "
-             "launcher, actor-0, actor-1, sim-0 and sim-1 (scripts/pki.sh --out DIR)");
+  bench::add_variant_options(cmd, &which, &security_dir,
+                             "learner, launcher, actor-0, actor-1, sim-0 and sim-1 "
+                             "(scripts/pki.sh --out DIR)");
   try {
     if (!cmd.parse(argc, argv)) return 0;
   } catch (const cli::UsageError& e) {
     std::cerr << e.what() << "\n";
     return 2;
   }
+  std::vector<bench::TransportVariant> variants;
   try {
-    if (selected(which, "dds-secure")) check_identities(security_dir);
+    variants = bench::select_variants(which, security_dir, participants());
   } catch (const transport::TransportError& e) {
     std::cerr << e.what() << "\n(make the PKI: scripts/pki.sh --out DIR)\n";
     return 2;
   }
-  const std::vector<Variant> variants = select_variants(which, security_dir);
   for (bool pinned : {false, true}) {
-    for (const Variant& v : variants) {
+    for (const bench::TransportVariant& v : variants) {
       for (int actors = 1; actors <= kMaxActors; ++actors) {
         run_case(v, actors, seconds, ratio, pinned);
       }

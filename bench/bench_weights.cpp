@@ -44,6 +44,7 @@
 #include "common/transport.hpp"
 #include "common/transport_options.hpp"
 #include "synthetic_experience.hpp"
+#include "transport_variants.hpp"
 
 namespace {
 
@@ -53,22 +54,6 @@ using Clock = std::chrono::steady_clock;
 // layout (--layout extended): 17 + 6 inputs.
 constexpr int kStateDim = 23;
 constexpr int kActionDim = 6;
-
-/// One transport the bench runs over: its name in the output and its configuration. A secured
-/// one (DDS Security: dds.security_dir set) gives each process an identity of its own.
-struct Variant {
-  std::string name;
-  transport::TransportConfig config;
-};
-
-/// The configuration of participant `identity` (a name in scripts/pki.sh's directory): config
-/// itself when it is not secured.
-transport::TransportConfig as_participant(const transport::TransportConfig& config,
-                                          const std::string& identity) {
-  transport::TransportConfig c = config;
-  if (!c.dds.security_dir.empty()) c.dds.security_identity = identity;
-  return c;
-}
 
 /// The identities of a secured case besides the learner's and the subscribers' (actor-K).
 constexpr const char* kMonitorIdentity = "launcher";  // this process: reads stats, summaries
@@ -152,7 +137,7 @@ std::vector<pid_t> start_subscribers(const transport::TransportConfig& config,
   for (int k = 0; k < subscribers; ++k) {
     const pid_t pid = fork();
     if (pid == 0) {
-      subscriber(as_participant(config, "actor-" + std::to_string(k)),
+      subscriber(bench::as_participant(config, "actor-" + std::to_string(k)),
                  dir + "/sub" + std::to_string(k), stop_path);
       _exit(0);
     }
@@ -174,7 +159,8 @@ std::vector<std::string> learner_arguments(const transport::TransportConfig& con
                                            "64",
                                            "--replay-capacity",
                                            "100000"};
-  for (const std::string& a : transport::transport_arguments(as_participant(config, "learner"))) {
+  for (const std::string& a :
+       transport::transport_arguments(bench::as_participant(config, "learner"))) {
     learner_argv.push_back(a);
   }
   return learner_argv;
@@ -210,7 +196,7 @@ void feeder(const transport::TransportConfig& config, double seconds) {
 /// This program's command line in an internal mode (`mode` `value`, a fresh process: exec, not
 /// fork, since the caller's transport has threads) over v, as participant `identity` when
 /// secured.
-std::vector<std::string> self_arguments(const Variant& v, const std::string& mode,
+std::vector<std::string> self_arguments(const bench::TransportVariant& v, const std::string& mode,
                                         const std::string& value, const std::string& identity) {
   std::vector<std::string> argv = {"/proc/self/exe", mode, value, "--transport",
                                    transport::to_string(v.config.kind)};
@@ -222,7 +208,7 @@ std::vector<std::string> self_arguments(const Variant& v, const std::string& mod
 }
 
 /// The feeder process for `seconds`; handles this process' messages until it has finished.
-void run_feeder(transport::Transport& transport, const Variant& v, double seconds,
+void run_feeder(transport::Transport& transport, const bench::TransportVariant& v, double seconds,
                 const std::string& dir) {
   test_support::ChildProcess feed(
       self_arguments(v, "--feeder", std::to_string(seconds), kFeederIdentity), dir + "/feeder.log");
@@ -245,9 +231,9 @@ void wait_until_quiet(transport::Transport& transport, const std::int64_t& newes
 
 /// The late joiner: a fresh process that subscribes while the learner is quiet; prints what it
 /// got.
-void run_late_joiner(transport::Transport& transport, const Variant& v, const std::string& hidden,
-                     const std::string& dir, std::int64_t published_before,
-                     const std::int64_t& newest_version) {
+void run_late_joiner(transport::Transport& transport, const bench::TransportVariant& v,
+                     const std::string& hidden, const std::string& dir,
+                     std::int64_t published_before, const std::int64_t& newest_version) {
   const std::string late_path = dir + "/late";
   test_support::ChildProcess late(
       self_arguments(v, "--late-joiner", late_path, kLateJoinerIdentity), dir + "/late.log");
@@ -284,12 +270,13 @@ void print_subscribers(const std::string& name, const std::string& hidden, const
 
 /// One case: subscribers, auv_learner training on synthetic experience for `seconds`, the late
 /// joiner, then one line per subscriber.
-void run_case(const Variant& v, const std::string& hidden, double seconds, int subscribers) {
+void run_case(const bench::TransportVariant& v, const std::string& hidden, double seconds,
+              int subscribers) {
   const std::string dir = test_support::make_temp_dir("auvrl_bench_weights_");
   const std::string stop_path = dir + "/stop";
   const std::vector<pid_t> children = start_subscribers(v.config, dir, stop_path, subscribers);
   test_support::ChildProcess learner(learner_arguments(v.config, hidden), dir + "/learner.log");
-  auto transport = transport::make_transport(as_participant(v.config, kMonitorIdentity));
+  auto transport = transport::make_transport(bench::as_participant(v.config, kMonitorIdentity));
   transport::Latest<auvrl_lcm::learner_stats_t> stats(*transport, channels::kLearnerStats);
   std::int64_t newest_version = -1;
   transport::subscribe<auvrl_lcm::policy_summary_t>(
@@ -318,41 +305,12 @@ void run_case(const Variant& v, const std::string& hidden, double seconds, int s
   print_subscribers(v.name, hidden, dir, subscribers, last);
 }
 
-/// Whether --transport `which` runs the variant `name` (lcm, dds, dds-secure; both: lcm and dds;
-/// dds-both: dds and dds-secure; all: the three).
-bool selected(const std::string& which, const std::string& name) {
-  if (which == name || which == "all") return true;
-  if (which == "both") return name == "lcm" || name == "dds";
-  return which == "dds-both" && (name == "dds" || name == "dds-secure");
-}
-
-/// The variants --transport selects, dds-secure with scripts/pki.sh's directory.
-std::vector<Variant> select_variants(const std::string& which, const std::string& security_dir) {
-  Variant lcm{"lcm", {}}, dds{"dds", {}}, secure{"dds-secure", {}};
-  dds.config.kind = secure.config.kind = transport::TransportKind::kDds;
-  secure.config.dds.security_dir = security_dir;
-  std::vector<Variant> variants;
-  for (const Variant& v : {lcm, dds, secure}) {
-    if (selected(which, v.name)) variants.push_back(v);
-  }
-  return variants;
-}
-
-/// Refuses (TransportError) a secured run whose directory lacks a valid identity for one of
-/// the processes, before anything starts.
-void check_identities(const std::string& dir, int subscribers) {
-  if (dir.empty()) {
-    throw transport::TransportError("--transport dds-secure needs --dds-security DIR");
-  }
-  if (std::filesystem::exists(std::filesystem::path(dir) / "cert.pem")) {
-    throw transport::TransportError(dir + " is one participant's directory, not scripts/pki.sh's");
-  }
+/// The participants a secured run needs besides the learner's and the subscribers' (actor-K).
+std::vector<std::string> participants(int subscribers) {
   std::vector<std::string> names = {"learner", kMonitorIdentity, kFeederIdentity,
                                     kLateJoinerIdentity};
   for (int k = 0; k < subscribers; ++k) names.push_back("actor-" + std::to_string(k));
-  for (const std::string& name : names) {
-    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
-  }
+  return names;
 }
 
 /// The internal modes: the late joiner (writes to late_joiner_path) or the feeder (for
@@ -383,14 +341,10 @@ int main(int argc, char** argv) {
   cmd.option("subscribers", &subscribers, "subscriber processes");
   cmd.option("hidden", &hidden_list, "comma-separated actor sizes");
   std::string which = "both";
-  cmd.option("transport", &which,
-             "lcm, dds, dds-secure (DDS Security), both (lcm and dds), dds-both (dds and "
-             "dds-secure) or all (one after the other, same run)");
-  cmd.choices("transport", {"lcm", "dds", "dds-secure", "both", "dds-both", "all"});
   std::string security_dir;
-  cmd.option("dds-security", &security_dir,
-             "dds-secure: a directory made by scripts/pki.sh with the participants learner, "
-             "launcher, feeder, late-joiner and actor-K per subscriber (see bench_weights.cpp)");
+  bench::add_variant_options(cmd, &which, &security_dir,
+                             "learner, launcher, feeder, late-joiner and actor-K per subscriber "
+                             "(see bench_weights.cpp)");
   std::string late_joiner_path;
   cmd.option("late-joiner", &late_joiner_path,
              "(internal) be the late joiner over --transport, write the result here");
@@ -406,9 +360,9 @@ int main(int argc, char** argv) {
   if (!late_joiner_path.empty() || feeder_seconds >= 0) {
     return run_internal(which, security_dir, late_joiner_path, feeder_seconds);
   }
-  const std::vector<Variant> variants = select_variants(which, security_dir);
+  std::vector<bench::TransportVariant> variants;
   try {
-    if (selected(which, "dds-secure")) check_identities(security_dir, subscribers);
+    variants = bench::select_variants(which, security_dir, participants(subscribers));
   } catch (const transport::TransportError& e) {
     std::cerr << e.what() << "\n(make the PKI: scripts/pki.sh --out DIR --actors " << subscribers
               << " --participant actor:feeder --participant actor:late-joiner)\n";
@@ -417,7 +371,7 @@ int main(int argc, char** argv) {
   std::size_t start = 0;
   while (start <= hidden_list.size()) {
     const auto comma = std::min(hidden_list.find(',', start), hidden_list.size());
-    for (const Variant& v : variants) {
+    for (const bench::TransportVariant& v : variants) {
       run_case(v, hidden_list.substr(start, comma - start), seconds, subscribers);
     }
     start = comma + 1;

@@ -294,6 +294,7 @@ identity sim-1
 start simC C "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_c[@]}" --vehicles 1 \
   --first-vehicle-id 1
 # An actor's first episode waits until the learner and the logger read its experience.
+# shellcheck disable=SC2054  # learner,logger is one value, a list of roles
 actor_args=(--layout extended --reward shaped --max-steps 100 --noise gaussian
   --wait-for-readers learner,logger)
 identity actor-0

@@ -57,7 +57,10 @@ participants+=("${extra[@]+"${extra[@]}"}")
 roles=$("$bin/auvrl" dds-policy roles | cut -f1)
 for p in "${participants[@]}"; do
   role=${p%%:*} name=${p#*:}
-  grep -qx "$role" <<<"$roles" || { echo "pki.sh: unknown role '$role' in '$p' (roles: $(echo $roles))" >&2; exit 2; }
+  grep -qx "$role" <<<"$roles" || {
+    echo "pki.sh: unknown role '$role' in '$p' (roles: ${roles//$'\n'/ })" >&2
+    exit 2
+  }
   [[ "$name" =~ ^[A-Za-z0-9_.-]+$ ]] || { echo "pki.sh: bad participant name '$name'" >&2; exit 2; }
 done
 
