@@ -262,7 +262,7 @@ class DdsTransport final : public Transport {
                              names);
       }
     } catch (...) {
-      for (dds_entity_t e : sub->entities) dds_delete(e);
+      delete_entities(sub->entities);
       throw;
     }
     subscriptions_.emplace(id, std::move(sub));
@@ -325,7 +325,7 @@ class DdsTransport final : public Transport {
     bool removed = false;
     RawHandler handler;
     std::vector<dds_entity_t> readers;
-    std::vector<dds_entity_t> entities;  ///< readers and their topic entities
+    std::vector<dds_entity_t> entities;  ///< topic entities and their readers, in creation order
     ~Subscription() {
       if (regex_ok) regfree(&regex);
     }
@@ -343,6 +343,12 @@ class DdsTransport final : public Transport {
                            std::to_string(domain_id_) + ": " + dds_error(rc));
     }
     return rc;
+  }
+
+  /// Deletes a subscription's entities, newest first: each reader before the topic entity it
+  /// reads.
+  static void delete_entities(const std::vector<dds_entity_t>& entities) {
+    for (auto e = entities.rbegin(); e != entities.rend(); ++e) dds_delete(*e);
   }
 
   /// The roles of the readers a writer has matched (their user data, see reader_tag_).
@@ -379,7 +385,7 @@ class DdsTransport final : public Transport {
   }
 
   void remove(std::map<SubscriptionId, std::unique_ptr<Subscription>>::iterator it) {
-    for (dds_entity_t e : it->second->entities) dds_delete(e);
+    delete_entities(it->second->entities);
     subscriptions_.erase(it);
     rebuild_reader_list();
   }
