@@ -3,7 +3,6 @@
 // (--dds-security, a directory made by scripts/pki.sh) each process is a participant of its own.
 #pragma once
 
-#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -46,20 +45,6 @@ inline void add_variant_options(cli::CommandLine& cmd, std::string* which,
              "dds-secure: a directory made by scripts/pki.sh with the participants " + pki_help);
 }
 
-/// Refuses (TransportError) a secured run whose directory lacks a valid identity for one of
-/// `names`, before anything starts.
-inline void check_identities(const std::string& dir, const std::vector<std::string>& names) {
-  if (dir.empty()) {
-    throw transport::TransportError("--transport dds-secure needs --dds-security DIR");
-  }
-  if (std::filesystem::exists(std::filesystem::path(dir) / "cert.pem")) {
-    throw transport::TransportError(dir + " is one participant's directory, not scripts/pki.sh's");
-  }
-  for (const std::string& name : names) {
-    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
-  }
-}
-
 /// The variants --transport `which` selects, dds-secure with scripts/pki.sh's directory, which
 /// must hold the participants `names` (else TransportError).
 inline std::vector<TransportVariant> select_variants(const std::string& which,
@@ -75,7 +60,12 @@ inline std::vector<TransportVariant> select_variants(const std::string& which,
                           (which == "dds-both" && v.name != "lcm");
     if (selected) variants.push_back(v);
   }
-  if (variants.back().name == "dds-secure") check_identities(security_dir, names);
+  if (variants.back().name == "dds-secure") {
+    if (security_dir.empty()) {
+      throw transport::TransportError("--transport dds-secure needs --dds-security DIR");
+    }
+    transport::check_dds_identities(security_dir, names);
+  }
   return variants;
 }
 

@@ -16,6 +16,7 @@
 #include <memory>
 
 #include "common/channels.hpp"
+#include "common/openssl_error.hpp"
 #include "common/transport.hpp"
 
 namespace auvrl::transport {
@@ -72,20 +73,15 @@ std::vector<DdsRole> make_roles() {
   };
 }
 
+/// Every domain a secured system may use, as governance and permissions write it.
+std::string all_domains() {
+  return fmt::format("<id_range><min>0</min><max>{}</max></id_range>", kSecuredMaxDomainId);
+}
+
 std::string topic_list(const std::vector<int>& topics) {
   std::string xml;
   for (int t : topics) xml += fmt::format("<topic>{}</topic>", channels::kDdsTopics[t].name);
   return xml;
-}
-
-/// The newest OpenSSL error as text.
-std::string openssl_error() {
-  const unsigned long code = ERR_get_error();
-  ERR_clear_error();
-  if (code == 0) return "";
-  char text[256];
-  ERR_error_string_n(code, text, sizeof text);
-  return std::string(" (") + text + ")";
 }
 
 using Bio = std::unique_ptr<BIO, decltype(&BIO_free)>;
@@ -224,8 +220,7 @@ std::string dds_governance_xml(int system_domain) {
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
   <domain_access_rules>
 )" + domain_rule(fmt::format("<id>{}</id>", system_domain), topic_rule("*", "ENCRYPT")) +
-         domain_rule(fmt::format("<id_range><min>0</min><max>{}</max></id_range>",
-                                 kSecuredMaxDomainId),
+         domain_rule(all_domains(),
                      topic_rule("auvrl_sim_*", "NONE") + topic_rule("*", "ENCRYPT")) +
          "  </domain_access_rules>\n</dds>\n";
 }
@@ -241,8 +236,7 @@ std::string dds_permissions_xml(const DdsRole& role, const std::vector<std::stri
     if (subject.find_first_of("<>&\"'") != std::string::npos) {
       throw TransportError("DDS Security: the subject '" + subject + "' has XML characters");
     }
-    std::string rule = fmt::format(
-        "<domains><id_range><min>0</min><max>{}</max></id_range></domains>", kSecuredMaxDomainId);
+    std::string rule = "<domains>" + all_domains() + "</domains>";
     if (!role.publish.empty())
       rule += "<publish><topics>" + topic_list(role.publish) + "</topics></publish>";
     if (!role.subscribe.empty()) {
@@ -288,6 +282,9 @@ DdsSecurityFiles resolve_dds_security(const std::string& dir, const std::string&
       throw TransportError("DDS Security: " + *p + " is missing or cannot be read");
     }
     *p = fs::absolute(*p).lexically_normal().string();
+    if (p->find_first_of("<>&\"'") != std::string::npos) {
+      throw TransportError("DDS Security: the path '" + *p + "' has XML characters");
+    }
   }
   return f;
 }
@@ -296,6 +293,17 @@ void check_dds_security_files(const DdsSecurityFiles& f) {
   check_certificate(f);
   check_signed_document(f.governance, f.permissions_ca);
   check_signed_document(f.permissions, f.permissions_ca);
+}
+
+void check_dds_identities(const std::string& dir, const std::vector<std::string>& names) {
+  if (fs::exists(fs::path(dir) / "cert.pem")) {
+    throw TransportError("DDS Security: " + dir +
+                         " is one participant's directory; this needs the whole directory that "
+                         "scripts/pki.sh made (it gives each process its own identity)");
+  }
+  for (const std::string& name : names) {
+    check_dds_security_files(resolve_dds_security(dir, name));
+  }
 }
 
 int dds_governance_system_domain(const std::string& governance_path) {
@@ -311,12 +319,6 @@ int dds_governance_system_domain(const std::string& governance_path) {
 }
 
 std::string dds_security_config_xml(const DdsSecurityFiles& f) {
-  for (const std::string* p : {&f.identity_ca, &f.certificate, &f.private_key, &f.permissions_ca,
-                               &f.governance, &f.permissions}) {
-    if (p->find_first_of("<>&\"'") != std::string::npos) {
-      throw TransportError("DDS Security: the path '" + *p + "' has XML characters");
-    }
-  }
   return fmt::format(
       "<Security><Authentication>"
       R"(<Library path="dds_security_auth" initFunction="init_authentication" )"

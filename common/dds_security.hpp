@@ -73,11 +73,17 @@ DdsSecurityFiles resolve_dds_security(const std::string& dir, const std::string&
 /// Throws TransportError.
 void check_dds_security_files(const DdsSecurityFiles& files);
 
+/// Checks the files of every participant `names` in dir, a directory made by scripts/pki.sh (a
+/// single participant's directory is refused): what a program that starts several processes
+/// does before starting any. Throws TransportError naming the first that fails.
+void check_dds_identities(const std::string& dir, const std::vector<std::string>& names);
+
 /// The system domain a signed governance document (governance.p7s) was made for: its first
 /// domain rule's single id. Throws TransportError if it has none.
 int dds_governance_system_domain(const std::string& governance_path);
 
-/// The <Security> element of a Cyclone domain configuration for these files.
+/// The <Security> element of a Cyclone domain configuration for these files (as
+/// resolve_dds_security gives them: absolute paths, checked free of XML characters).
 std::string dds_security_config_xml(const DdsSecurityFiles& files);
 
 }  // namespace auvrl::transport

@@ -14,21 +14,13 @@
 #include <vector>
 
 #include "common/nn/file_io.hpp"
+#include "common/openssl_error.hpp"
 
 namespace auvrl::signature {
 
 namespace {
 
 constexpr std::size_t kSignatureBytes = 64;  // Ed25519
-
-/// The newest OpenSSL error as text ("" if none).
-std::string openssl_error() {
-  const unsigned long code = ERR_get_error();
-  if (code == 0) return "";
-  char text[256];
-  ERR_error_string_n(code, text, sizeof text);
-  return std::string(": ") + text;
-}
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }

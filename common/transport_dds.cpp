@@ -613,7 +613,10 @@ void check_dds_settings(const DdsSettings& s, bool allow_off_host) {
   }
 }
 
-std::string dds_default_config_xml(const DdsSettings& s) {
+namespace {
+
+/// The generated configuration, with security_xml (a <Security> element, or "") in its domain.
+std::string generated_config_xml(const DdsSettings& s, const std::string& security_xml) {
   bool all_loopback = true;
   for (const std::string& peer : s.peers) all_loopback = all_loopback && is_loopback_peer(peer);
   std::string xml = R"(<CycloneDDS><Domain id="any"><General>)";
@@ -623,31 +626,45 @@ std::string dds_default_config_xml(const DdsSettings& s) {
   for (const std::string& peer : s.peers) xml += R"(<Peer address=")" + peer + R"("/>)";
   xml += "</Peers><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
          std::to_string(s.max_auto_participant_index) + "</MaxAutoParticipantIndex></Discovery>";
-  if (!s.security_dir.empty()) {
-    xml += dds_security_config_xml(resolve_dds_security(s.security_dir, s.security_identity));
+  return xml + security_xml + "</Domain></CycloneDDS>";
+}
+
+/// The participant's security files, checked, and its system bus in the governance's domain.
+DdsSecurityFiles checked_security_files(const DdsSettings& settings) {
+  const DdsSecurityFiles files =
+      resolve_dds_security(settings.security_dir, settings.security_identity);
+  check_dds_security_files(files);
+  // The governance encrypts everything in its system domain only: a system bus in another
+  // domain would carry the simulator topics in clear.
+  const int system_domain = dds_governance_system_domain(files.governance);
+  if (!settings.private_lockstep_bus && settings.domain_id != system_domain) {
+    throw TransportError("DDS Security: " + files.governance + " was made for system domain " +
+                         std::to_string(system_domain) + ", but this bus is domain " +
+                         std::to_string(settings.domain_id) +
+                         " (make the PKI with scripts/pki.sh --domain " +
+                         std::to_string(settings.domain_id) + ")");
   }
-  return xml + "</Domain></CycloneDDS>";
+  return files;
+}
+
+}  // namespace
+
+std::string dds_default_config_xml(const DdsSettings& s) {
+  return generated_config_xml(
+      s, s.security_dir.empty()
+             ? ""
+             : dds_security_config_xml(resolve_dds_security(s.security_dir, s.security_identity)));
 }
 
 std::unique_ptr<Transport> make_dds_transport(const DdsSettings& settings, bool allow_off_host) {
   check_dds_settings(settings, allow_off_host);
-  if (!settings.security_dir.empty()) {
-    const DdsSecurityFiles files =
-        resolve_dds_security(settings.security_dir, settings.security_identity);
-    check_dds_security_files(files);
-    // The governance encrypts everything in its system domain only: a system bus in another
-    // domain would carry the simulator topics in clear.
-    const int system_domain = dds_governance_system_domain(files.governance);
-    if (!settings.private_lockstep_bus && settings.domain_id != system_domain) {
-      throw TransportError("DDS Security: " + files.governance + " was made for system domain " +
-                           std::to_string(system_domain) + ", but this bus is domain " +
-                           std::to_string(settings.domain_id) +
-                           " (make the PKI with scripts/pki.sh --domain " +
-                           std::to_string(settings.domain_id) + ")");
-    }
-  }
-  const std::string config = settings.config_path.empty() ? dds_default_config_xml(settings)
-                                                          : "file://" + settings.config_path;
+  // The security files are read and checked once; the configuration names them.
+  const std::string security_xml = settings.security_dir.empty()
+                                       ? ""
+                                       : dds_security_config_xml(checked_security_files(settings));
+  const std::string config = settings.config_path.empty()
+                                 ? generated_config_xml(settings, security_xml)
+                                 : "file://" + settings.config_path;
   return std::make_unique<DdsTransport>(settings, config);
 }
 

@@ -108,16 +108,7 @@ void check_identities(const RunContext& ctx) {
     names.push_back("actor-" + std::to_string(i));
     names.push_back("sim-" + std::to_string(i));
   }
-  const std::string& dir = ctx.rc.transport.dds.security_dir;
-  if (fs::exists(fs::path(dir) / "cert.pem")) {
-    throw transport::TransportError(
-        "DDS Security: " + dir +
-        " is one participant's directory; auvrl train needs the whole directory that "
-        "scripts/pki.sh made (it gives each process its own identity)");
-  }
-  for (const std::string& name : names) {
-    transport::check_dds_security_files(transport::resolve_dds_security(dir, name));
-  }
+  transport::check_dds_identities(ctx.rc.transport.dds.security_dir, names);
 }
 
 /// The private lockstep bus of pair i: an LCM port, or a DDS domain, of its own.
