@@ -29,9 +29,23 @@ void PolicyController::set_network(nn::Mlp network) {
   network_ = std::move(network);
 }
 
-void PolicyController::act(const task::Observation&, const Eigen::Vector3d&,
+void PolicyController::use_integral_action(const task::TaskConfig& task) {
+  integral_task_.reset();
+  if (task.integral.enabled()) integral_task_ = task;
+  goal_offset_ned_m_.setZero();
+}
+
+void PolicyController::act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
                            const task::StateVector& state, task::ActionVector& action) {
-  action = network_.forward(state);
+  if (!integral_task_) {
+    action = network_.forward(state);
+    return;
+  }
+  const Eigen::Vector3d moved_goal_ned_m = task::advance_goal_integral(
+      *integral_task_, goal_ned_m, observation.position_ned_m, goal_offset_ned_m_);
+  moved_state_ = state;
+  task::relabel_state(*integral_task_, goal_ned_m, moved_goal_ned_m, moved_state_);
+  action = network_.forward(moved_state_);
 }
 
 namespace {
@@ -65,7 +79,10 @@ std::unique_ptr<PolicyController> load_policy(const std::string& path,
     throw std::runtime_error(where + ": " + e.what());
   }
   try {
-    return std::make_unique<PolicyController>(std::move(network), task.state_dim(), num_thrusters);
+    auto policy =
+        std::make_unique<PolicyController>(std::move(network), task.state_dim(), num_thrusters);
+    policy->use_integral_action(task);
+    return policy;
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + " with the " + task::to_string(task.layout) +
                              " layout: " + e.what());

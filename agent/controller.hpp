@@ -24,13 +24,22 @@ class Controller {
   virtual std::string name() const = 0;
 };
 
-/// The learned policy mu(x | theta): the actor network on the task's observation vector.
+/// The learned policy mu(x | theta): the actor network on the task's observation vector. With
+/// integral action on (use_integral_action), it is shown the goal moved by the task's goal
+/// integrator (task::GoalIntegralSettings) instead of the goal itself.
 class PolicyController final : public Controller {
  public:
   /// Throws std::invalid_argument if the network's input/output sizes do not match.
   PolicyController(nn::Mlp network, int state_dim, int num_thrusters);
-  void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector& state,
-           task::ActionVector& action) override;
+  /// Integral action as task.integral says (off when its gain is 0). The actors' exploring
+  /// policy never uses it; a policy that drives does.
+  void use_integral_action(const task::TaskConfig& task);
+  /// Clears the integrator (the start of an episode or mission).
+  void reset() override { goal_offset_ned_m_.setZero(); }
+  void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
+           const task::StateVector& state, task::ActionVector& action) override;
+  /// The integrator's goal offset now, NED, m.
+  const Eigen::Vector3d& goal_offset_ned_m() const { return goal_offset_ned_m_; }
   std::string name() const override { return "policy"; }
   /// Replaces the network (new weights from the learner); same size checks.
   void set_network(nn::Mlp network);
@@ -40,11 +49,15 @@ class PolicyController final : public Controller {
   nn::Mlp network_;
   int state_dim_;
   int num_thrusters_;
+  std::optional<task::TaskConfig> integral_task_;  ///< set when integral action is on
+  Eigen::Vector3d goal_offset_ned_m_ = Eigen::Vector3d::Zero();
+  task::StateVector moved_state_;
 };
 
 /// The policy in a network file, for a vehicle with num_thrusters thrusters: reads the file
 /// (its CRC-32 checked), takes `layout` or infers it from the network's input size
-/// (task::infer_layout), checks the sizes and sets task.layout. Throws std::runtime_error
+/// (task::infer_layout), checks the sizes and sets task.layout; integral action as
+/// task.integral says (it drives). Throws std::runtime_error
 /// naming the file, the vehicle and what was expected.
 std::unique_ptr<PolicyController> load_policy(const std::string& path,
                                               const std::string& vehicle_name, int num_thrusters,

@@ -80,7 +80,9 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
   t.field("random_heading_fraction", &C::random_heading_fraction, "0..1",
           "of them, starting at a random heading");
   t.field("randomised_fraction", &C::randomised_fraction, "0..1",
-          "of them, under the conditions task.randomise draws (faults, currents, noise, model)");
+          "of them, under the conditions finetune.randomise draws (faults, currents, noise, "
+          "model)");
+  t.section("randomise", task::randomise_table(), &C::randomise);
   add_objective_fields(t);
   t.field("threads", &C::threads, "0: one per CPU", "policies evaluated at once");
   return t;

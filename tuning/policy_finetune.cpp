@@ -48,6 +48,9 @@ void FinetuneConfig::validate() const {
   require(threads >= 0, "threads must be >= 0");
   require(randomised_fraction >= 0 && randomised_fraction <= 1,
           "randomised_fraction must be in [0, 1]");
+  std::string key;
+  const std::string what = randomise.check(key);
+  require(what.empty(), "randomise." + key + " " + what);
 }
 
 std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
@@ -79,7 +82,7 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
       e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
     }
     const task::EpisodeConditions conditions =
-        task::sample_conditions(task.randomise, task.num_thrusters, conditions_rng);
+        task::sample_conditions(config.randomise, task.num_thrusters, conditions_rng);
     if (spread(randomised, i)) agent::apply_conditions(conditions, e.start);
     e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
     episodes.push_back(e);
@@ -192,7 +195,10 @@ FinetuneResult finetune_policy(
                                    : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   threads = std::min(threads, 2 * config.pairs);
   std::vector<agent::PolicyController> workers;
-  for (int w = 0; w < threads; ++w) workers.emplace_back(start, state_dim, n);
+  for (int w = 0; w < threads; ++w) {
+    workers.emplace_back(start, state_dim, n);
+    workers.back().use_integral_action(task);
+  }
   nn::Mlp scratch = start;
 
   // Mean objective of weights theta, with controller c (its network replaced).

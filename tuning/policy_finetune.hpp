@@ -15,7 +15,7 @@
 // The objective's way-points are drawn from the task's goal region with a stream of their own
 // (never the evaluation's suite nor the launcher's validation way-points), from the task's
 // fixed start, a fraction of them facing a random heading (as test2 does), a fraction under the
-// conditions the task's randomisation draws for training.
+// conditions the fine-tuning's own randomisation (finetune.randomise) draws.
 #pragma once
 
 #include <Eigen/Core>
@@ -39,10 +39,14 @@ struct FinetuneConfig {
   double learning_rate = 0.01;  ///< Adam's step on the rank-weighted direction
   int episodes = 24;            ///< way-points the objective averages over (fixed for the run)
   double random_heading_fraction = 0.25;  ///< of them, starting at a random heading
-  /// Of them, this share (spread through the list) also gets the conditions the task's
-  /// randomisation (task.randomise) draws for training episodes: faults, currents, sensor noise,
-  /// a wrong model; from the fine-tuning's own stream. 0: the vehicle file's, in still water.
+  /// Of them, this share (spread through the list) also gets the conditions `randomise` draws:
+  /// faults, currents, sensor noise, a wrong model; from the fine-tuning's own stream. 0: the
+  /// vehicle file's, in still water.
   double randomised_fraction = 0.0;
+  /// The fine-tuning's own randomisation (the actors' is task.randomise): TD3 can learn in still
+  /// water, where it learns fastest, and the fine-tuning still see the conditions a vehicle
+  /// meets.
+  task::EpisodeRandomisation randomise;
   /// Objective of one way-point, s: the time to within the reach radius (interpolated
   /// between control steps, so that braking a little later counts before it gains a whole
   /// step) plus hold_weight times the mean distance over the arrival step and the hold_steps

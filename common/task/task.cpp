@@ -95,6 +95,13 @@ void TaskConfig::validate() const {
   spread(start_velocity_max_body_mps, 5.0, "start_velocity_max_body_mps");
   spread(start_rate_max_body_rad_s, 2.0, "start_rate_max_body_rad_s");
   randomise.validate();
+  if (!(integral.gain_per_s >= 0 && integral.gain_per_s <= 10)) {
+    throw std::invalid_argument("task.integral.gain_per_s must be in [0, 10] (1/s)");
+  }
+  positive(integral.radius_m, "integral.radius_m");
+  if (!(integral.max_offset_m >= 0) || !std::isfinite(integral.max_offset_m)) {
+    throw std::invalid_argument("task.integral.max_offset_m must be finite and >= 0");
+  }
   if (!start_position_ned_m.allFinite() || !goal_min_ned_m.allFinite() ||
       !goal_max_ned_m.allFinite() || (goal_max_ned_m - goal_min_ned_m).minCoeff() < 0) {
     throw std::invalid_argument("task: goal region must be finite with min <= max");
@@ -181,6 +188,19 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
   error_body += r.transpose() * shift;
   state.segment<3>(kExtError) = (error_body / c.scales.position_m).cast<float>();
   state[kExtDistance] = static_cast<float>(error_body.norm() / c.scales.position_m);
+}
+
+Eigen::Vector3d advance_goal_integral(const TaskConfig& c, const Eigen::Vector3d& goal_ned_m,
+                                      const Eigen::Vector3d& position_ned_m,
+                                      Eigen::Vector3d& offset_ned_m) {
+  const GoalIntegralSettings& s = c.integral;
+  const Eigen::Vector3d error_ned_m = goal_ned_m - position_ned_m;
+  if (s.enabled() && error_ned_m.norm() <= s.radius_m) {
+    offset_ned_m += s.gain_per_s * c.control_step_s * error_ned_m;
+    const double length_m = offset_ned_m.norm();
+    if (length_m > s.max_offset_m) offset_ned_m *= s.max_offset_m / length_m;
+  }
+  return goal_ned_m + offset_ned_m;
 }
 
 Eigen::Vector3d position_from_state(const TaskConfig& c, const Eigen::Vector3d& goal,

@@ -67,6 +67,22 @@ struct ObservationScales {
   double depth_m = 10.0;
 };
 
+/// Integral action for a policy that drives (evaluation, fine-tuning, missions, deployment;
+/// never the actors' training episodes): the goal the policy is shown is moved by the integral
+/// of the position error, so that a steady push (a current, extra buoyancy, a weak thruster)
+/// that the policy answers with a steady offset is driven out, as a PID's integral term does.
+/// Each control step within radius_m of the goal: offset += gain_per_s * control_step_s *
+/// (goal - position), NED, its length clamped to max_offset_m (anti-windup).
+struct GoalIntegralSettings {
+  /// How fast the goal moves per metre of error, 1/s (0: off). Against a constant push the
+  /// offset settles with time constant 1 / gain_per_s.
+  double gain_per_s = 0.1;
+  /// The integrator runs only this close to the goal, m: it corrects the hold, not the transit.
+  double radius_m = 1.0;
+  double max_offset_m = 1.0;  ///< m
+  bool enabled() const { return gain_per_s > 0.0; }
+};
+
 /// Every constant of the task. Defaults are the paper's where it gives one.
 struct TaskConfig {
   StateLayout layout = StateLayout::kPaper;
@@ -129,6 +145,9 @@ struct TaskConfig {
   /// sensor noise and model variation drawn per episode by the actors (randomisation.hpp).
   EpisodeRandomisation randomise;
 
+  /// The driving policy's integral action (not the paper's: its preset turns it off).
+  GoalIntegralSettings integral;
+
   /// Size of the observation vector.
   int state_dim() const;
   /// Throws std::invalid_argument naming the first unusable value.
@@ -140,6 +159,8 @@ void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task);
 
 /// The keys of a `task:` section (common/task/task_yaml.cpp).
 const config::Table<TaskConfig>& task_table();
+/// The keys of a `randomise:` section (task.randomise, finetune.randomise).
+const config::Table<EpisodeRandomisation>& randomise_table();
 
 /// What the vehicle reports, as the task uses it.
 struct Observation {
@@ -160,6 +181,12 @@ Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& euler_rpy_rad);
 void build_state(const TaskConfig& config, const Observation& obs,
                  const Eigen::Vector3d& goal_ned_m, const ActionVector& previous_action,
                  StateVector& out, const std::vector<double>& thrust_realised_n = {});
+
+/// One control step of the goal integrator (GoalIntegralSettings): moves offset_ned_m by the
+/// error from position_ned_m to goal_ned_m when within the radius, and returns goal + offset.
+Eigen::Vector3d advance_goal_integral(const TaskConfig& config, const Eigen::Vector3d& goal_ned_m,
+                                      const Eigen::Vector3d& position_ned_m,
+                                      Eigen::Vector3d& offset_ned_m);
 
 /// Rewrites a stored observation vector for another goal (hindsight relabelling): only the
 /// goal-dependent entries change (x_e; or body-frame error and distance).

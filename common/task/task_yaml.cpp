@@ -23,8 +23,9 @@ config::Table<ObservationScales> make_scales_table() {
 config::Table<EpisodeRandomisation> make_randomise_table() {
   using R = EpisodeRandomisation;
   config::Table<R> t("randomise",
-                     "randomised training episodes (actors only): per kind, the share of "
-                     "episodes that get it and [low, high] ranges drawn uniformly");
+                     "randomised episodes (task.randomise: the actors'; finetune.randomise: the "
+                     "fine-tuning's): per kind, the share of episodes that get it and [low, "
+                     "high] ranges drawn uniformly");
   t.field("fault_probability", &R::fault_probability, "",
           "share of episodes with one thruster, chosen uniformly, impaired")
       .range(0.0, 1.0);
@@ -80,6 +81,21 @@ config::Table<EpisodeRandomisation> make_randomise_table() {
   return t;
 }
 
+config::Table<GoalIntegralSettings> make_integral_table() {
+  using G = GoalIntegralSettings;
+  config::Table<G> t("integral",
+                     "integral action of a driving policy (evaluation, fine-tuning, missions, "
+                     "deployment; not the actors' training episodes): the goal it is shown moves "
+                     "by the integral of the position error");
+  t.field("gain_per_s", &G::gain_per_s, "1/s, 0: off",
+          "per control step within radius_m: offset += gain * step * (goal - position)")
+      .range(0.0, 10.0);
+  t.field("radius_m", &G::radius_m, "m", "the integrator runs only this close to the goal");
+  t.field("max_offset_m", &G::max_offset_m, "m", "the offset's largest length (anti-windup)")
+      .range(0.0);
+  return t;
+}
+
 /// The reward's terms.
 void add_reward_fields(config::Table<TaskConfig>& t) {
   using C = TaskConfig;
@@ -125,7 +141,8 @@ void add_episode_fields(config::Table<TaskConfig>& t) {
           "random starts: u, v, w uniform in +- this");
   t.field("start_rate_max_body_rad_s", &C::start_rate_max_body_rad_s, "rad/s",
           "random starts: p, q, r uniform in +- this");
-  t.section("randomise", make_randomise_table(), &C::randomise);
+  t.section("randomise", randomise_table(), &C::randomise);
+  t.section("integral", make_integral_table(), &C::integral);
 }
 
 config::Table<TaskConfig> make_task_table() {
@@ -150,6 +167,11 @@ config::Table<GoalScheduleConfig> make_schedule_table() {
 }
 
 }  // namespace
+
+const config::Table<EpisodeRandomisation>& randomise_table() {
+  static const config::Table<EpisodeRandomisation> table = make_randomise_table();
+  return table;
+}
 
 const config::Table<TaskConfig>& task_table() {
   static const config::Table<TaskConfig> table = make_task_table();

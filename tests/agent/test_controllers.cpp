@@ -75,6 +75,46 @@ TEST(PolicyController, SetNetworkChecksSizesAndKeepsTheOldOneOnError) {
   EXPECT_NO_THROW(policy.set_network(actor(23, 6)));
 }
 
+// With integral action the network sees the state built for the goal moved by the task's
+// integrator (within 1e-6 of building it for that goal: the controller rewrites the goal
+// entries of the state it is given); reset() clears the offset; gain 0 leaves the state as is.
+TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
+  task::TaskConfig task;
+  task.layout = task::StateLayout::kExtended;
+  task::apply_vehicle(nessie().facts(), task);
+  const int dim = task.state_dim();
+  PolicyController policy(actor(dim, 6), dim, 6);
+  policy.use_integral_action(task);
+  nn::Mlp reference = actor(dim, 6);
+  task::Observation obs;
+  obs.position_ned_m = Eigen::Vector3d(2.0, 1.0, 6.0);
+  obs.euler_rpy_rad = Eigen::Vector3d(0.05, -0.1, 1.2);
+  obs.velocity_body_mps = Eigen::Vector3d(0.1, 0.0, -0.05);
+  const Eigen::Vector3d goal(2.3, 0.6, 6.2);  // 0.54 m off: inside the 1 m radius
+  const task::ActionVector previous = task::ActionVector::Constant(6, 0.2f);
+  task::StateVector state, moved_state;
+  task::build_state(task, obs, goal, previous, state);
+  task::ActionVector action;
+  Eigen::Vector3d expected_offset = Eigen::Vector3d::Zero();
+  for (int t = 0; t < 30; ++t) {
+    policy.act(obs, goal, state, action);
+    const Eigen::Vector3d moved =
+        task::advance_goal_integral(task, goal, obs.position_ned_m, expected_offset);
+    task::build_state(task, obs, moved, previous, moved_state);
+    EXPECT_LE((action - reference.forward(moved_state)).cwiseAbs().maxCoeff(), 1e-6) << t;
+  }
+  EXPECT_LE((policy.goal_offset_ned_m() - expected_offset).norm(), 1e-12);
+  EXPECT_NEAR(policy.goal_offset_ned_m().norm(), 30 * 0.1 * 0.1 * (goal - obs.position_ned_m).norm(),
+              1e-9);
+  policy.reset();
+  EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
+  task.integral.gain_per_s = 0.0;
+  policy.use_integral_action(task);
+  policy.act(obs, goal, state, action);
+  EXPECT_EQ(action, reference.forward(state));
+  EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
+}
+
 TEST(PidController, PseudoInverseReproducesTheFiveControllableDof) {
   const PidController pid(nessie());
   const Eigen::MatrixXd b = nessie().allocation;

@@ -5,11 +5,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "agent/controller.hpp"
 #include "agent/pid_controller.hpp"
 #include "agent_test_util.hpp"
 #include "eval/robustness.hpp"
@@ -340,6 +343,33 @@ TEST(RobustnessComparison, EachCriterionOfTheBar) {
       << table;
   EXPECT_NE(table.find("30.0 vs - pass"), std::string::npos) << table;
   EXPECT_NE(table.find("2 of 3 groups pass every criterion"), std::string::npos) << table;
+}
+
+// The policy's integral action (task.integral) drives out what a steady push leaves: the
+// committed policy against 2 kg of extra buoyancy holds closer with it than without it.
+TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
+  EvaluationConfig c = config();
+  task::apply_vehicle(nessie().facts(), c.task);
+  const std::vector<EvaluationEpisode> episodes =
+      of_group(robustness_episodes(c, 6, 4, 1), "buoyancy_+2kg");
+  ASSERT_EQ(episodes.size(), 4u);
+  const auto mean_hold_m = [&](double gain_per_s) {
+    EvaluationConfig with = c;
+    with.task.integral.gain_per_s = gain_per_s;
+    auto policy = agent::load_policy(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
+                                     nessie().name, 6, std::nullopt, with.task);
+    double sum = 0.0;
+    for (const EvaluationEpisode& e : episodes) {
+      const SummaryRow row = run_evaluation_episode(nessie(), with, *policy, e, nullptr);
+      EXPECT_TRUE(row.reached) << e.index;
+      sum += row.mean_error_after_reach_m;
+    }
+    return sum / static_cast<double>(episodes.size());
+  };
+  const double without_m = mean_hold_m(0.0), with_m = mean_hold_m(0.1);
+  std::cout << "mean hold error with 2 kg of extra buoyancy: " << without_m << " m without integral "
+            << "action, " << with_m << " m with it\n";
+  EXPECT_LT(with_m, 0.6 * without_m);
 }
 
 TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {

@@ -115,7 +115,7 @@ TEST_F(ReproducibleRunTest, TheBudgetIsCheckedForTrainingOnly) {
   const RunContext ctx = load_run_context(options);
   EXPECT_TRUE(ctx.rc.run.reproducible);
   EXPECT_EQ(ctx.rc.learner_max_updates, 3000);
-  EXPECT_DOUBLE_EQ(ctx.rc.run.max_train_s, 85.0);  // kept, not used
+  EXPECT_DOUBLE_EQ(ctx.rc.run.max_train_s, 35.0);  // the preset's, kept, not used
 
   // learner.max_episodes is a budget too.
   RunConfig episodes;

@@ -78,7 +78,7 @@ TEST(LearnerSection, ReadsTheSmoothnessTermsAndRefusesNegativeWeightsNamingTheKe
 
 // The smoothness terms are off in the paper, fast and smooth presets, on in robust.yaml.
 TEST(LearnerSection, OnlyTheRobustPresetSmoothsTheCommands) {
-  for (const std::string preset : {"paper", "fast", "smooth", "robust"}) {
+  for (const std::string preset : {"paper", "fast", "robust"}) {
     LearnerNodeConfig config;
     read_learner_config_file(std::string(AUVRL_CONFIG_DIR) + "/presets/" + preset + ".yaml",
                              config);

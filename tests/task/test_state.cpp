@@ -245,6 +245,55 @@ TEST(Relabel, ToTheSameGoalChangesNothing) {
   EXPECT_LT((s - before).cwiseAbs().maxCoeff(), 1e-6f);
 }
 
+// The goal integrator: within its radius the offset moves by gain x step x error (NED); outside
+// it, or with the gain at 0, nothing moves; its length never exceeds max_offset_m.
+TEST(GoalIntegral, IntegratesTheErrorInsideItsRadiusAndClampsTheOffset) {
+  TaskConfig c;
+  c.control_step_s = 0.1;
+  c.integral.gain_per_s = 0.5;
+  c.integral.radius_m = 1.0;
+  c.integral.max_offset_m = 0.3;
+  const Eigen::Vector3d goal(4.0, -2.0, 6.0);
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  // 0.4 m short of it along north: +0.02 m a step.
+  Eigen::Vector3d moved = advance_goal_integral(c, goal, goal - Eigen::Vector3d(0.4, 0, 0), offset);
+  EXPECT_NEAR(offset.x(), 0.02, 1e-15);
+  EXPECT_EQ(moved, goal + offset);
+  // 1.5 m away: outside the radius, the offset stays (and still moves the goal).
+  moved = advance_goal_integral(c, goal, goal + Eigen::Vector3d(0, 1.5, 0), offset);
+  EXPECT_NEAR(offset.x(), 0.02, 1e-15);
+  EXPECT_EQ(offset.y(), 0.0);
+  EXPECT_EQ(moved, goal + offset);
+  // Held off long enough, it stops at its largest length, in the error's direction.
+  for (int t = 0; t < 100; ++t) {
+    advance_goal_integral(c, goal, goal - Eigen::Vector3d(0.0, 0.6, 0.8), offset);
+  }
+  EXPECT_NEAR(offset.norm(), 0.3, 1e-12);
+  EXPECT_GT(offset.dot(Eigen::Vector3d(0.0, 0.6, 0.8)), 0.29);
+  // Off: the goal itself.
+  c.integral.gain_per_s = 0.0;
+  Eigen::Vector3d none = Eigen::Vector3d::Zero();
+  EXPECT_EQ(advance_goal_integral(c, goal, goal - Eigen::Vector3d(0.4, 0, 0), none), goal);
+  EXPECT_EQ(none, Eigen::Vector3d::Zero());
+}
+
+TEST(GoalIntegral, UnusableSettingsAreRefusedByName) {
+  TaskConfig c;
+  c.integral.gain_per_s = -0.1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.integral.gain_per_s = 0.1;
+  c.integral.radius_m = 0.0;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.integral.radius_m = 1.0;
+  c.integral.max_offset_m = std::nan("");
+  try {
+    c.validate();
+    ADD_FAILURE() << "a NaN max_offset_m was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("task.integral.max_offset_m"), std::string::npos);
+  }
+}
+
 TEST(PositionFromState, RecoversThePositionInEveryLayout) {
   for (StateLayout layout :
        {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {

@@ -69,12 +69,14 @@ void write_raw(const std::string& path, const std::vector<T>& values) {
   ASSERT_TRUE(out.good()) << path;
 }
 
-std::vector<float> read_floats(const std::string& path) {
+template <class T>
+std::vector<T> read_raw(const std::string& path) {
   const std::vector<std::uint8_t> bytes = nn::read_file(path);
-  std::vector<float> values(bytes.size() / sizeof(float));
-  std::memcpy(values.data(), bytes.data(), values.size() * sizeof(float));
+  std::vector<T> values(bytes.size() / sizeof(T));
+  std::memcpy(values.data(), bytes.data(), values.size() * sizeof(T));
   return values;
 }
+std::vector<float> read_floats(const std::string& path) { return read_raw<float>(path); }
 
 /// kSamples states of `dim` entries, uniform in [-1, 1]: the range the task's scales bring
 /// every input to.
@@ -282,6 +284,47 @@ TEST_P(PolicyExportLayout, BuildsTheStateAndActsAsAuvrlDoes) {
 
 INSTANTIATE_TEST_SUITE_P(AllLayouts, PolicyExportLayout,
                          testing::Values("paper", "extended", "extended_thrust"));
+
+// The header's integral action moves the way-point as the policy controller's does
+// (task::advance_goal_integral), step by step: inside and outside its radius, and up to its
+// largest offset.
+TEST(PolicyExportC, IntegratesTheGoalAsAuvrlDoes) {
+  const std::string cc = find_program("cc");
+  if (cc.empty()) GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
+  TempDir dir;
+  const std::string exe = build_driver(dir, kPolicy, cc);
+  ASSERT_FALSE(exe.empty());
+  task::TaskConfig c;
+  task::apply_vehicle(nessie().facts(), c);
+  ASSERT_TRUE(c.integral.enabled());
+  // A vehicle held off its way-point by a steady push (0.62 m) and wandering about that
+  // (+-0.4 m an axis), every 7th step 1.5 m away (outside the 1 m radius): the offset grows
+  // about 6 mm a step until it reaches its largest length (1 m).
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  const Eigen::Vector3d goal(3.0, -2.0, 8.0), push(-0.5, 0.3, 0.2);
+  std::vector<double> records, expected;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  int inside = 0;
+  for (int t = 0; t < 3000; ++t) {
+    Eigen::Vector3d position = goal + Eigen::Vector3d(1.5, 0.0, 0.0);
+    if (t % 7 != 6) position = goal + push + Eigen::Vector3d(u(rng), u(rng), u(rng));
+    records.insert(records.end(), {position[0], position[1], position[2], goal[0], goal[1], goal[2]});
+    inside += (goal - position).norm() <= c.integral.radius_m;
+    const Eigen::Vector3d moved = task::advance_goal_integral(c, goal, position, offset);
+    expected.insert(expected.end(), {moved[0], moved[1], moved[2]});
+  }
+  EXPECT_GT(inside, 1500);
+  EXPECT_LE(inside, 3000 - 428);
+  EXPECT_NEAR(offset.norm(), c.integral.max_offset_m, 1e-9);
+  write_raw(dir.path("nav.f64"), records);
+  std::string log;
+  ASSERT_EQ(run({exe, "integrate", dir.path("nav.f64"), dir.path("moved.f64")},
+                dir.path("run.log"), &log),
+            0)
+      << log;
+  EXPECT_LE(max_abs_difference(read_raw<double>(dir.path("moved.f64")), expected), 1e-12);
+}
 
 TEST(PolicyExportC, DocumentsLayoutScalesAndThrusters) {
   const ExportedPolicy policy = load_exported_policy(kPolicy, vehicle_path(), "");

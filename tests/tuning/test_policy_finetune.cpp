@@ -64,16 +64,19 @@ TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
   for (const auto& e : a) EXPECT_NE(e.goal_ned_m, first_suite_goal);
 }
 
-// randomised_fraction: that share of the way-points gets the task's randomised conditions (every
-// kind on here, so each randomised episode gets a fault), the way-points and headings unchanged.
+// randomised_fraction: that share of the way-points gets the conditions finetune.randomise draws
+// (every kind on here, so each randomised episode gets a fault), the way-points and headings
+// unchanged; the task's own randomisation (the actors') does not reach them.
 TEST(FinetuneEpisodes, RandomiseTheFractionAskedWithoutMovingTheWayPoints) {
   FinetuneConfig c;
   c.episodes = 20;
   task::TaskConfig t = fast_task();
   t.randomise.fault_probability = 1.0;
   t.randomise.model_probability = 1.0;
-  const auto still = finetune_episodes(t, c, 7);
   c.randomised_fraction = 0.5;
+  const auto still = finetune_episodes(t, c, 7);
+  c.randomise.fault_probability = 1.0;
+  c.randomise.model_probability = 1.0;
   const auto a = finetune_episodes(t, c, 7);
   const auto b = finetune_episodes(t, c, 7);
   int randomised = 0;
@@ -283,10 +286,13 @@ TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
   EXPECT_EQ(r.best_objective,
             r.iterations[static_cast<std::size_t>(r.best_iteration - 1)].objective);
   // The returned network is the one that scored best_objective, on the way-points with the
-  // PID's arrivals; without them the lag term would be missing.
+  // PID's arrivals (without them the lag term would be missing) and with the task's integral
+  // action, as the fine-tuning ran it.
   std::vector<FinetuneEpisode> episodes = finetune_episodes(fast_task(), c, 1);
   agent::PolicyController start(detuned_policy(), fast_task().state_dim(), 6);
   agent::PolicyController best(r.network, fast_task().state_dim(), 6);
+  start.use_integral_action(fast_task());
+  best.use_integral_action(fast_task());
   double start_without_pid = 0.0;
   for (const FinetuneEpisode& e : episodes) {
     start_without_pid += arrival_objective(nessie(), fast_task(), start, e, c);

@@ -56,8 +56,11 @@ std::string opening_comment(const ExportedPolicy& policy) {
       "  auvrl_nav nav;          (the vehicle's navigation data, SI units, see below)\n"
       "  double goal_ned_m[3];   (the way-point, NED, m)\n"
       "  float previous[AUVRL_POLICY_NUM_ACTIONS];  (zeros at the start, then the last action)\n"
+      "  double offset_ned_m[3];  (zeros at the start of a mission; kept across way-points)\n"
+      "  double moved_goal_ned_m[3];\n"
       "  float state[AUVRL_POLICY_STATE_DIM], action[AUVRL_POLICY_NUM_ACTIONS];\n"
-      "  auvrl_policy_build_state(&nav, goal_ned_m, previous, state);\n"
+      "  auvrl_policy_integrate_goal(offset_ned_m, &nav, goal_ned_m, moved_goal_ned_m);\n"
+      "  auvrl_policy_build_state(&nav, moved_goal_ned_m, previous, state);\n"
       "  auvrl_policy_act(state, action);\n"
       "  thrust command of thruster i (N) = action[i] * AUVRL_POLICY_MAX_THRUST_N;\n"
       "  copy action into previous.\n";
@@ -79,6 +82,13 @@ std::string macros(const ExportedPolicy& policy) {
       "#define AUVRL_POLICY_MAX_WIDTH {}\n"
       "/* Action +-1 = +- this thrust, N. */\n"
       "#define AUVRL_POLICY_MAX_THRUST_N {}\n"
+      "/* The control step, s. */\n"
+      "#define AUVRL_POLICY_CONTROL_STEP_S {}\n"
+      "/* Integral action (auvrl_policy_integrate_goal): gain 1/s (0: off), radius and largest\n"
+      " * offset, m. */\n"
+      "#define AUVRL_POLICY_INTEGRAL_GAIN_PER_S {}\n"
+      "#define AUVRL_POLICY_INTEGRAL_RADIUS_M {}\n"
+      "#define AUVRL_POLICY_INTEGRAL_MAX_OFFSET_M {}\n"
       "/* Scales: a state entry is the quantity divided by its scale. */\n"
       "#define AUVRL_POLICY_SCALE_POSITION_M {}\n"
       "#define AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS {}\n"
@@ -87,7 +97,10 @@ std::string macros(const ExportedPolicy& policy) {
       "/* Thruster i's name (action i). */\n",
       task::to_string(policy.task.layout), spec.input_dim, spec.output_dim,
       policy.vehicle.num_thrusters(), policy.network.num_params(), width,
-      c_double_literal(policy.task.max_thrust_n), c_double_literal(k.position_m),
+      c_double_literal(policy.task.max_thrust_n), c_double_literal(policy.task.control_step_s),
+      c_double_literal(policy.task.integral.gain_per_s),
+      c_double_literal(policy.task.integral.radius_m),
+      c_double_literal(policy.task.integral.max_offset_m), c_double_literal(k.position_m),
       c_double_literal(k.linear_velocity_mps), c_double_literal(k.angular_rate_rad_s),
       c_double_literal(k.depth_m));
   for (int i = 0; i < policy.vehicle.num_thrusters(); ++i) {
@@ -244,13 +257,49 @@ std::string build_state_function(const ExportedPolicy& policy) {
   return out + "}\n";
 }
 
+/// auvrl_policy_integrate_goal: task::advance_goal_integral in C.
+std::string integrate_goal_function() {
+  return "/* Integral action, as auvrl's policy controller does it (task::advance_goal_integral):\n"
+         " * once per control step, before auvrl_policy_build_state, which then takes\n"
+         " * moved_goal_ned_m. Within AUVRL_POLICY_INTEGRAL_RADIUS_M of the way-point the offset\n"
+         " * moves by gain x control step x (way-point - position), NED, its length clamped to\n"
+         " * AUVRL_POLICY_INTEGRAL_MAX_OFFSET_M; moved_goal_ned_m = way-point + offset. Zero\n"
+         " * offset_ned_m at the start of a mission and keep it across way-points. */\n"
+         "static inline void auvrl_policy_integrate_goal(double offset_ned_m[3], const auvrl_nav "
+         "*nav,\n"
+         "                                               const double goal_ned_m[3],\n"
+         "                                               double moved_goal_ned_m[3]) {\n"
+         "  double error_ned[3], error_sq = 0.0, offset_sq = 0.0;\n"
+         "  int i;\n"
+         "  for (i = 0; i < 3; ++i) {\n"
+         "    error_ned[i] = goal_ned_m[i] - nav->position_ned_m[i];\n"
+         "    error_sq += error_ned[i] * error_ned[i];\n"
+         "  }\n"
+         "  if (AUVRL_POLICY_INTEGRAL_GAIN_PER_S > 0.0 && sqrt(error_sq) <= "
+         "AUVRL_POLICY_INTEGRAL_RADIUS_M) {\n"
+         "    for (i = 0; i < 3; ++i) {\n"
+         "      offset_ned_m[i] +=\n"
+         "          AUVRL_POLICY_INTEGRAL_GAIN_PER_S * AUVRL_POLICY_CONTROL_STEP_S * "
+         "error_ned[i];\n"
+         "      offset_sq += offset_ned_m[i] * offset_ned_m[i];\n"
+         "    }\n"
+         "    if (sqrt(offset_sq) > AUVRL_POLICY_INTEGRAL_MAX_OFFSET_M) {\n"
+         "      const double shrink = AUVRL_POLICY_INTEGRAL_MAX_OFFSET_M / sqrt(offset_sq);\n"
+         "      for (i = 0; i < 3; ++i) offset_ned_m[i] *= shrink;\n"
+         "    }\n"
+         "  }\n"
+         "  for (i = 0; i < 3; ++i) moved_goal_ned_m[i] = goal_ned_m[i] + offset_ned_m[i];\n"
+         "}\n";
+}
+
 }  // namespace
 
 std::string policy_c_header(const ExportedPolicy& policy) {
   return opening_comment(policy) +
          "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
          macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
-         nav_struct(policy) + "\n" + build_state_function(policy) +
+         nav_struct(policy) + "\n" + integrate_goal_function() + "\n" +
+         build_state_function(policy) +
          "\n#endif /* AUVRL_POLICY_H */\n";
 }
 

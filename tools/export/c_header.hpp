@@ -4,6 +4,8 @@
 //     file's, in nn::Mlp::params()'s layout (each layer's weight matrix, out x in,
 //     column-major, layer 0 first; then each layer's bias);
 //   - auvrl_policy_act(state, action): the forward pass (ReLU hidden layers, tanh output);
+//   - auvrl_policy_integrate_goal(offset, nav, goal, moved_goal): the policy's integral action
+//     (task::advance_goal_integral), which moves the way-point the state is built for;
 //   - auvrl_nav and auvrl_policy_build_state(nav, goal, previous_action, state): the state
 //     vector built from the vehicle's navigation data the way task::build_state builds it for
 //     the policy's layout, with the scales baked in (computed in double, stored as float, as

@@ -183,6 +183,16 @@ std::string describe_policy(const ExportedPolicy& policy) {
       policy.vehicle.num_thrusters(), policy.task.max_thrust_n, task::to_string(policy.task.layout),
       k.position_m, k.linear_velocity_mps, k.angular_rate_rad_s, k.depth_m,
       policy.task.max_thrust_n);
+  const task::GoalIntegralSettings& integral = policy.task.integral;
+  out += integral.enabled()
+             ? fmt::format(
+                   "Integral action: the state is built for the way-point moved by an offset\n"
+                   "  that grows by {} x {} s x (way-point - position) each control step within\n"
+                   "  {} m of it, at most {} m long (auvrl's task::advance_goal_integral; the C\n"
+                   "  export's auvrl_policy_integrate_goal).\n",
+                   integral.gain_per_s, policy.task.control_step_s, integral.radius_m,
+                   integral.max_offset_m)
+             : std::string("Integral action: off (the state is built for the way-point).\n");
   return out + describe_state_text(policy) + describe_action_text(policy);
 }
 

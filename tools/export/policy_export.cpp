@@ -18,8 +18,9 @@ void run_export_request(const ExportRequest& request, std::ostream& out) {
   if (request.format != "c" && request.format != "onnx") {
     throw std::invalid_argument("--format '" + request.format + "': expected c or onnx");
   }
-  const ExportedPolicy policy =
+  ExportedPolicy policy =
       load_exported_policy(request.policy_path, request.vehicle_path, request.layout);
+  policy.task.integral.gain_per_s = request.integral_gain_per_s;
   std::string what;
   if (request.format == "c") {
     const std::string header = policy_c_header(policy);

@@ -8,6 +8,9 @@
  *                                      roll/pitch/yaw, body velocity, body rates, realised
  *                                      thrust x n, previous action x n, goal NED) -> float32
  *                                      states (auvrl_policy_build_state)
+ *   policy_driver integrate NAV GOALS  float64 records of 6 values (position NED, way-point
+ *                                      NED), one control step each, from a zero offset ->
+ *                                      float64 moved way-points (auvrl_policy_integrate_goal)
  *   policy_driver params PARAMS        auvrl_policy_params as float32
  */
 #include <stdio.h>
@@ -48,6 +51,18 @@ static int build_state(FILE *in, FILE *out) {
   return 0;
 }
 
+static int integrate(FILE *in, FILE *out) {
+  double r[6], offset_ned_m[3] = {0.0, 0.0, 0.0}, moved_goal_ned_m[3];
+  auvrl_nav nav;
+  memset(&nav, 0, sizeof nav);
+  while (fread(r, sizeof r, 1, in) == 1) {
+    memcpy(nav.position_ned_m, r, sizeof nav.position_ned_m);
+    auvrl_policy_integrate_goal(offset_ned_m, &nav, r + 3, moved_goal_ned_m);
+    if (fwrite(moved_goal_ned_m, sizeof moved_goal_ned_m, 1, out) != 1) return 1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   FILE *in = NULL, *out = NULL;
   int status = 2;
@@ -58,7 +73,8 @@ int main(int argc, char **argv) {
     return fclose(out) == 0 ? status : 1;
   }
   if (argc != 4) {
-    fprintf(stderr, "usage: policy_driver act|state IN OUT, or policy_driver params OUT\n");
+    fprintf(stderr,
+            "usage: policy_driver act|state|integrate IN OUT, or policy_driver params OUT\n");
     return 2;
   }
   in = fopen(argv[2], "rb");
@@ -66,6 +82,7 @@ int main(int argc, char **argv) {
   if (in != NULL && out != NULL) {
     if (strcmp(argv[1], "act") == 0) status = act(in, out);
     if (strcmp(argv[1], "state") == 0) status = build_state(in, out);
+    if (strcmp(argv[1], "integrate") == 0) status = integrate(in, out);
   } else {
     status = 1;
   }
