@@ -288,7 +288,7 @@ ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
                                 " of the reference; expected the same episodes");
   }
   ValidationScore score;
-  double time_sum = 0, hold_sum = 0, worst_ratio = 0;
+  double time_sum = 0, hold_sum = 0, worst_ratio = 0, energy_sum = 0, smoothness_sum = 0;
   bool any_ratio = false;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const SummaryRow& r = rows[i];
@@ -301,6 +301,8 @@ ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
                                   std::to_string(ref.episode) + ")");
     }
     ++score.episodes;
+    energy_sum += r.thrust_energy;
+    smoothness_sum += r.smoothness;
     if (!r.reached) continue;
     ++score.reached;
     time_sum += r.time_to_reach_s;
@@ -315,6 +317,10 @@ ValidationScore score_against_reference(const std::vector<SummaryRow>& rows,
     score.mean_hold_m = hold_sum / score.reached;
   }
   if (any_ratio) score.max_time_ratio = worst_ratio;
+  if (score.episodes > 0) {
+    score.mean_energy = energy_sum / score.episodes;
+    score.mean_smoothness = smoothness_sum / score.episodes;
+  }
   return score;
 }
 

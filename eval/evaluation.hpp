@@ -154,6 +154,10 @@ struct ValidationScore {
   /// Worst ratio of the candidate's time to reach to the reference's, over the way-points both
   /// reached (kNone: none): below 1, it reached every way-point sooner than the reference.
   double max_time_ratio = kNone;
+  /// Means over every way-point (reached or not) of the episode's thrust energy and command
+  /// smoothness (SummaryRow::thrust_energy, smoothness).
+  double mean_energy = 0.0;
+  double mean_smoothness = 0.0;
 };
 
 /// Scores `rows` (the candidate's) against `reference` (the same episodes, in the same order,

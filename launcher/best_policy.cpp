@@ -33,7 +33,7 @@ void BestPolicyKeeper::restore(std::ostream& out) {
 void BestPolicyKeeper::consider(const nn::Mlp& net, std::int64_t version, double wall_s,
                                 QuickEvalSink& quick_eval) {
   const eval::ValidationScore score = quick_.evaluate(net);
-  const bool keep = best_version_ < 0 || eval::ranks_above(score, best_, {max_hold_m_, true});
+  const bool keep = best_version_ < 0 || eval::ranks_above(score, best_, {max_hold_m_, true, std::nullopt});
   if (keep) {
     best_ = score;
     best_version_ = version;
@@ -44,7 +44,7 @@ void BestPolicyKeeper::consider(const nn::Mlp& net, std::int64_t version, double
 
 bool BestPolicyKeeper::best_ranks_above(const std::string& path) const {
   const nn::Mlp last = nn::network_from_bytes(nn::read_file(path), 1);
-  return eval::ranks_above(best_, quick_.evaluate(last), {max_hold_m_, true});
+  return eval::ranks_above(best_, quick_.evaluate(last), {max_hold_m_, true, std::nullopt});
 }
 
 void SnapshotReviewer::remove(const PolicySnapshot& snapshot, std::ostream& out) {

@@ -36,8 +36,21 @@ namespace {
 
 std::string describe(const eval::ValidationScore& v) {
   return fmt::format(
-      "{}/{} reached, mean {:.2f} s, hold {:.2f} m, worst time ratio to the PID {:.2f}", v.reached,
-      v.episodes, v.mean_time_s, v.mean_hold_m, v.max_time_ratio);
+      "{}/{} reached, mean {:.2f} s, hold {:.2f} m, worst time ratio to the PID {:.2f}, energy "
+      "{:.1f}, smoothness {:.4f}",
+      v.reached, v.episodes, v.mean_time_s, v.mean_hold_m, v.max_time_ratio, v.mean_energy,
+      v.mean_smoothness);
+}
+
+/// How the fine-tuning keeps its weights: by its own prices when it prices thrust, else by
+/// reach, hold and mean time (eval::Ranking).
+eval::Ranking finetune_ranking(const tuning::FinetuneConfig& config, double max_hold_m) {
+  eval::Ranking ranking{max_hold_m, false, std::nullopt};
+  if (config.energy_weight > 0.0 || config.smoothness_weight > 0.0) {
+    ranking.prices = eval::Ranking::Prices{config.hold_weight, config.energy_weight,
+                                           config.smoothness_weight};
+  }
+  return ranking;
 }
 
 /// The best validated weights of a fine-tuning so far.
@@ -58,6 +71,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       "way-points)\n",
       start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes);
   const eval::ValidationScore before = in.validation.evaluate(start);
+  const eval::Ranking ranking = finetune_ranking(in.config, in.max_hold_m);
   FinetuneBest best{before, std::nullopt, 0};
   FinetuneSink csv((fs::path(in.run_dir) / "finetune.csv").string());
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
@@ -67,7 +81,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
     }
     const eval::ValidationScore score = in.validation.evaluate(weights);
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
-    if (eval::ranks_above(score, best.score, {in.max_hold_m, false}))
+    if (eval::ranks_above(score, best.score, ranking))
       best = {score, weights, it.iteration};
     out << fmt::format(
         "auvrl train: fine-tuning {}/{}  objective {:.3f} s  validation {}/{} mean {:.2f} s  "

@@ -263,7 +263,7 @@ TEST(ValidationScore, RowsThatAreNotTheReferencesEpisodesAreAnError) {
 }
 
 TEST(Ranking, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
-  const Ranking training{0.15, true};
+  const Ranking training{0.15, true, std::nullopt};
   ValidationScore a, b;
   a.episodes = b.episodes = 40;
   a.reached = 40;
@@ -293,7 +293,7 @@ TEST(Ranking, RanksReachedThenHoldingThenWorstRatioThenMeanTime) {
 }
 
 TEST(Ranking, TheFineTuningsRankingSkipsTheWorstRatio) {
-  const Ranking finetuning{0.15, false};
+  const Ranking finetuning{0.15, false, std::nullopt};
   ValidationScore a, b;
   a.episodes = b.episodes = a.reached = b.reached = 40;
   a.mean_hold_m = b.mean_hold_m = 0.05;
@@ -303,9 +303,50 @@ TEST(Ranking, TheFineTuningsRankingSkipsTheWorstRatio) {
   b.mean_time_s = 9.0;
   EXPECT_TRUE(ranks_above(a, b, finetuning));
   EXPECT_FALSE(ranks_above(b, a, finetuning));
-  EXPECT_TRUE(ranks_above(b, a, Ranking{0.15, true}));
+  EXPECT_TRUE(ranks_above(b, a, Ranking{0.15, true, std::nullopt}));
   a.mean_hold_m = 0.3;  // holding still comes before time
   EXPECT_TRUE(ranks_above(b, a, finetuning));
+}
+
+// A fine-tuning that prices thrust keeps its weights by its prices: after reaching, the
+// smaller mean time + hold_weight x hold + energy_weight x energy + smoothness_weight x
+// smoothness, even against a sooner arrival that spends more thrust and chatters.
+TEST(Ranking, APricedFineTuningRanksByItsPricedTime) {
+  Ranking priced{0.15, false, Ranking::Prices{10.0, 0.1, 100.0}};
+  ValidationScore frugal, fast;
+  frugal.episodes = fast.episodes = frugal.reached = fast.reached = 40;
+  frugal.mean_time_s = 10.0;
+  frugal.mean_hold_m = 0.03;
+  frugal.mean_energy = 35.0;
+  frugal.mean_smoothness = 0.007;
+  fast.mean_time_s = 9.5;  // half a second sooner...
+  fast.mean_hold_m = 0.03;
+  fast.mean_energy = 60.0;  // ...for 2.5 s of energy
+  fast.mean_smoothness = 0.02;
+  EXPECT_DOUBLE_EQ(priced_time_s(frugal, *priced.prices), 10.0 + 0.3 + 3.5 + 0.7);
+  EXPECT_TRUE(ranks_above(frugal, fast, priced));
+  EXPECT_FALSE(ranks_above(fast, frugal, priced));
+  EXPECT_TRUE(ranks_above(fast, frugal, Ranking{0.15, false, std::nullopt}));  // unpriced
+  fast.reached = 41;  // reaching more still comes first
+  EXPECT_TRUE(ranks_above(fast, frugal, priced));
+}
+
+// The validation score's energy and smoothness are means over every way-point.
+TEST(Ranking, TheScoreCarriesMeanEnergyAndSmoothness) {
+  std::vector<SummaryRow> rows(2), reference(2);
+  for (int i = 0; i < 2; ++i) {
+    rows[static_cast<std::size_t>(i)].episode = reference[static_cast<std::size_t>(i)].episode = i;
+  }
+  rows[0].reached = true;
+  rows[0].time_to_reach_s = 8.0;
+  rows[0].thrust_energy = 30.0;
+  rows[0].smoothness = 0.01;
+  rows[1].thrust_energy = 50.0;  // not reached, still counted
+  rows[1].smoothness = 0.03;
+  const ValidationScore s = score_against_reference(rows, reference);
+  EXPECT_DOUBLE_EQ(s.mean_energy, 40.0);
+  EXPECT_DOUBLE_EQ(s.mean_smoothness, 0.02);
+  EXPECT_EQ(s.reached, 1);
 }
 
 TEST(Evaluation, InfersTheLayoutFromThePolicyInputs) {
