@@ -33,7 +33,8 @@ void BestPolicyKeeper::restore(std::ostream& out) {
 void BestPolicyKeeper::consider(const nn::Mlp& net, std::int64_t version, double wall_s,
                                 QuickEvalSink& quick_eval) {
   const eval::ValidationScore score = quick_.evaluate(net);
-  const bool keep = best_version_ < 0 || eval::ranks_above(score, best_, {max_hold_m_, true, std::nullopt});
+  const bool keep =
+      best_version_ < 0 || eval::ranks_above(score, best_, {max_hold_m_, true, std::nullopt});
   if (keep) {
     best_ = score;
     best_version_ = version;

@@ -47,8 +47,8 @@ std::string describe(const eval::ValidationScore& v) {
 eval::Ranking finetune_ranking(const tuning::FinetuneConfig& config, double max_hold_m) {
   eval::Ranking ranking{max_hold_m, false, std::nullopt};
   if (config.energy_weight > 0.0 || config.smoothness_weight > 0.0) {
-    ranking.prices = eval::Ranking::Prices{config.hold_weight, config.energy_weight,
-                                           config.smoothness_weight};
+    ranking.prices =
+        eval::Ranking::Prices{config.hold_weight, config.energy_weight, config.smoothness_weight};
   }
   return ranking;
 }
@@ -81,8 +81,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
     }
     const eval::ValidationScore score = in.validation.evaluate(weights);
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
-    if (eval::ranks_above(score, best.score, ranking))
-      best = {score, weights, it.iteration};
+    if (eval::ranks_above(score, best.score, ranking)) best = {score, weights, it.iteration};
     out << fmt::format(
         "auvrl train: fine-tuning {}/{}  objective {:.3f} s  validation {}/{} mean {:.2f} s  "
         "elapsed {}\n",

@@ -104,8 +104,8 @@ TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
     EXPECT_LE((action - reference.forward(moved_state)).cwiseAbs().maxCoeff(), 1e-6) << t;
   }
   EXPECT_LE((policy.goal_offset_ned_m() - expected_offset).norm(), 1e-12);
-  EXPECT_NEAR(policy.goal_offset_ned_m().norm(), 30 * 0.1 * 0.1 * (goal - obs.position_ned_m).norm(),
-              1e-9);
+  EXPECT_NEAR(policy.goal_offset_ned_m().norm(),
+              30 * 0.1 * 0.1 * (goal - obs.position_ned_m).norm(), 1e-9);
   policy.reset();
   EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
   task.integral.gain_per_s = 0.0;

@@ -367,7 +367,8 @@ TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
     return sum / static_cast<double>(episodes.size());
   };
   const double without_m = mean_hold_m(0.0), with_m = mean_hold_m(0.1);
-  std::cout << "mean hold error with 2 kg of extra buoyancy: " << without_m << " m without integral "
+  std::cout << "mean hold error with 2 kg of extra buoyancy: " << without_m
+            << " m without integral "
             << "action, " << with_m << " m with it\n";
   EXPECT_LT(with_m, 0.6 * without_m);
 }

@@ -309,7 +309,8 @@ TEST(PolicyExportC, IntegratesTheGoalAsAuvrlDoes) {
   for (int t = 0; t < 3000; ++t) {
     Eigen::Vector3d position = goal + Eigen::Vector3d(1.5, 0.0, 0.0);
     if (t % 7 != 6) position = goal + push + Eigen::Vector3d(u(rng), u(rng), u(rng));
-    records.insert(records.end(), {position[0], position[1], position[2], goal[0], goal[1], goal[2]});
+    records.insert(records.end(),
+                   {position[0], position[1], position[2], goal[0], goal[1], goal[2]});
     inside += (goal - position).norm() <= c.integral.radius_m;
     const Eigen::Vector3d moved = task::advance_goal_integral(c, goal, position, offset);
     expected.insert(expected.end(), {moved[0], moved[1], moved[2]});
@@ -319,8 +320,8 @@ TEST(PolicyExportC, IntegratesTheGoalAsAuvrlDoes) {
   EXPECT_NEAR(offset.norm(), c.integral.max_offset_m, 1e-9);
   write_raw(dir.path("nav.f64"), records);
   std::string log;
-  ASSERT_EQ(run({exe, "integrate", dir.path("nav.f64"), dir.path("moved.f64")},
-                dir.path("run.log"), &log),
+  ASSERT_EQ(run({exe, "integrate", dir.path("nav.f64"), dir.path("moved.f64")}, dir.path("run.log"),
+                &log),
             0)
       << log;
   EXPECT_LE(max_abs_difference(read_raw<double>(dir.path("moved.f64")), expected), 1e-12);

@@ -299,8 +299,7 @@ std::string policy_c_header(const ExportedPolicy& policy) {
          "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
          macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
          nav_struct(policy) + "\n" + integrate_goal_function() + "\n" +
-         build_state_function(policy) +
-         "\n#endif /* AUVRL_POLICY_H */\n";
+         build_state_function(policy) + "\n#endif /* AUVRL_POLICY_H */\n";
 }
 
 }  // namespace auvrl::tools
