@@ -442,7 +442,9 @@ std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& reque
                                                         const sim::VehicleModel& model,
                                                         EvaluationConfig& config) {
   const int n = model.num_thrusters();
-  config.task.num_thrusters = n;
+  // The vehicle's facts before the policy copies the task for its integral action (its
+  // control step).
+  task::apply_vehicle(model.facts(), config.task);
   if (!request.layout.empty()) config.task.layout = task::parse_layout(request.layout);
   if (request.controller == "pid") {
     if (!request.policy_path.empty()) {

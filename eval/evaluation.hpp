@@ -213,7 +213,8 @@ struct EvalRequest {
 };
 
 /// Builds the controller for a request: loads and checks the policy file (errors name the
-/// file and what was expected) or builds the PID from the model; sets config.task.layout.
+/// file and what was expected) or builds the PID from the model; applies the vehicle to
+/// config.task and sets its layout.
 std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& request,
                                                         const sim::VehicleModel& model,
                                                         EvaluationConfig& config);
