@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   cmd.option("layout", &options.layout, "state layout (default: inferred from the policy)");
   cmd.option("integral-gain", &options.integral_gain_per_s,
              "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cmd.check("integral-gain", CLI::Range(0.0, 10.0));
+  cmd.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
   cmd.option("trust-key", &options.trust_key,
              "Ed25519 public key (PEM): the mission and the policy must be signed by its private "
              "key (FILE.sig beside each; auvrl sign), else they are refused");

@@ -67,7 +67,7 @@ int run_eval(int argc, const char* const* argv) {
              "/ 17+2n)");
   cli.option("integral-gain", &request.integral_gain_per_s,
              "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cli.check("integral-gain", CLI::Range(0.0, 10.0));
+  cli.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
   cli.option("seed", &seed, "seed of the suite's way-points and the vehicle resets");
   cli.check("seed", auvrl::cli::at_least(0));
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
@@ -144,7 +144,7 @@ int run_export(int argc, const char* const* argv) {
              "/ 17+2n)");
   cli.option("integral-gain", &request.integral_gain_per_s,
              "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cli.check("integral-gain", CLI::Range(0.0, 10.0));
+  cli.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
   if (!cli.parse(argc, argv)) return 0;
   auvrl::tools::run_export_request(request, std::cout);
   return 0;

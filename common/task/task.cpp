@@ -1,5 +1,7 @@
 #include "common/task/task.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <stdexcept>
 
@@ -95,8 +97,9 @@ void TaskConfig::validate() const {
   spread(start_velocity_max_body_mps, 5.0, "start_velocity_max_body_mps");
   spread(start_rate_max_body_rad_s, 2.0, "start_rate_max_body_rad_s");
   randomise.validate();
-  if (!(integral.gain_per_s >= 0 && integral.gain_per_s <= 10)) {
-    throw std::invalid_argument("task.integral.gain_per_s must be in [0, 10] (1/s)");
+  if (!(integral.gain_per_s >= 0 && integral.gain_per_s <= GoalIntegralSettings::kMaxGainPerS)) {
+    throw std::invalid_argument(fmt::format("task.integral.gain_per_s must be in [0, {}] (1/s)",
+                                            GoalIntegralSettings::kMaxGainPerS));
   }
   positive(integral.radius_m, "integral.radius_m");
   if (!(integral.max_offset_m >= 0) || !std::isfinite(integral.max_offset_m)) {

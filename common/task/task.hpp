@@ -74,6 +74,8 @@ struct ObservationScales {
 /// Each control step within radius_m of the goal: offset += gain_per_s * control_step_s *
 /// (goal - position), NED, its length clamped to max_offset_m (anti-windup).
 struct GoalIntegralSettings {
+  /// The largest gain accepted, 1/s (a 0.1 s time constant: faster than any vehicle's loop).
+  static constexpr double kMaxGainPerS = 10.0;
   /// How fast the goal moves per metre of error, 1/s (0: off). Against a constant push the
   /// offset settles with time constant 1 / gain_per_s.
   double gain_per_s = 0.1;

@@ -89,7 +89,7 @@ config::Table<GoalIntegralSettings> make_integral_table() {
                      "by the integral of the position error");
   t.field("gain_per_s", &G::gain_per_s, "1/s, 0: off",
           "per control step within radius_m: offset += gain * step * (goal - position)")
-      .range(0.0, 10.0);
+      .range(0.0, G::kMaxGainPerS);
   t.field("radius_m", &G::radius_m, "m", "the integrator runs only this close to the goal");
   t.field("max_offset_m", &G::max_offset_m, "m", "the offset's largest length (anti-windup)")
       .range(0.0);
