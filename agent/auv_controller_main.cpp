@@ -6,6 +6,7 @@
 #include "agent/controller_process.hpp"
 #include "common/cli.hpp"
 #include "common/signals.hpp"
+#include "common/task/task_yaml.hpp"
 #include "common/transport_options.hpp"
 #include "common/unrecoverable.hpp"
 
@@ -25,9 +26,7 @@ int main(int argc, char** argv) {
   cmd.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the mission's vehicle:, else config/vehicles/nessie7.yaml)");
   cmd.option("layout", &options.layout, "state layout (default: inferred from the policy)");
-  cmd.option("integral-gain", &options.integral_gain_per_s,
-             "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cmd.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
+  auvrl::task::add_integral_gain_option(cmd, options.integral_gain_per_s);
   cmd.option("trust-key", &options.trust_key,
              "Ed25519 public key (PEM): the mission and the policy must be signed by its private "
              "key (FILE.sig beside each; auvrl sign), else they are refused");

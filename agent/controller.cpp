@@ -24,6 +24,11 @@ PolicyController::PolicyController(nn::Mlp network, int state_dim, int num_thrus
   check_sizes(network_, state_dim_, num_thrusters_);
 }
 
+PolicyController::PolicyController(nn::Mlp network, const task::TaskConfig& task)
+    : PolicyController(std::move(network), task.state_dim(), task.num_thrusters) {
+  use_integral_action(task);
+}
+
 void PolicyController::set_network(nn::Mlp network) {
   check_sizes(network, state_dim_, num_thrusters_);
   network_ = std::move(network);
@@ -79,10 +84,7 @@ std::unique_ptr<PolicyController> load_policy(const std::string& path,
     throw std::runtime_error(where + ": " + e.what());
   }
   try {
-    auto policy =
-        std::make_unique<PolicyController>(std::move(network), task.state_dim(), num_thrusters);
-    policy->use_integral_action(task);
-    return policy;
+    return std::make_unique<PolicyController>(std::move(network), task);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + " with the " + task::to_string(task.layout) +
                              " layout: " + e.what());

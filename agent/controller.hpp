@@ -31,6 +31,8 @@ class PolicyController final : public Controller {
  public:
   /// Throws std::invalid_argument if the network's input/output sizes do not match.
   PolicyController(nn::Mlp network, int state_dim, int num_thrusters);
+  /// A policy that drives: sizes from the task, integral action as task.integral says.
+  PolicyController(nn::Mlp network, const task::TaskConfig& task);
   /// Integral action as task.integral says (off when its gain is 0). The actors' exploring
   /// policy never uses it; a policy that drives does.
   void use_integral_action(const task::TaskConfig& task);

@@ -28,8 +28,7 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
 }
 
 ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network) const {
-  agent::PolicyController controller(network, task_.state_dim(), task_.num_thrusters);
-  controller.use_integral_action(task_);
+  agent::PolicyController controller(network, task_);
   return score_against_reference(run(controller), reference_);
 }
 

@@ -13,6 +13,7 @@
 #include "common/cli.hpp"
 #include "common/dds_security.hpp"
 #include "common/signature.hpp"
+#include "common/task/task_yaml.hpp"
 #include "common/transport_options.hpp"
 #include "eval/evaluation.hpp"
 #include "eval/mission_run.hpp"
@@ -65,9 +66,7 @@ int run_eval(int argc, const char* const* argv) {
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
-  cli.option("integral-gain", &request.integral_gain_per_s,
-             "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cli.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
+  auvrl::task::add_integral_gain_option(cli, request.integral_gain_per_s);
   cli.option("seed", &seed, "seed of the suite's way-points and the vehicle resets");
   cli.check("seed", auvrl::cli::at_least(0));
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
@@ -142,9 +141,7 @@ int run_export(int argc, const char* const* argv) {
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
-  cli.option("integral-gain", &request.integral_gain_per_s,
-             "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
-  cli.check("integral-gain", CLI::Range(0.0, auvrl::task::GoalIntegralSettings::kMaxGainPerS));
+  auvrl::task::add_integral_gain_option(cli, request.integral_gain_per_s);
   if (!cli.parse(argc, argv)) return 0;
   auvrl::tools::run_export_request(request, std::cout);
   return 0;

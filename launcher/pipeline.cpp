@@ -136,8 +136,7 @@ EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy
   config.task = ctx.rc.task;
   const std::vector<eval::Scenario> all = eval::parse_scenarios("all");
   const nn::Mlp policy_net = nn::network_from_bytes(nn::read_file(policy_path), 1);
-  agent::PolicyController policy(policy_net, ctx.rc.task.state_dim(), ctx.rc.task.num_thrusters);
-  policy.use_integral_action(ctx.rc.task);
+  agent::PolicyController policy(policy_net, ctx.rc.task);
   EvaluationResult result;
   result.policy_rows =
       eval::run_evaluation(ctx.model, config, policy, all, (eval_dir / "policy").string());

@@ -195,10 +195,7 @@ FinetuneResult finetune_policy(
                                    : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   threads = std::min(threads, 2 * config.pairs);
   std::vector<agent::PolicyController> workers;
-  for (int w = 0; w < threads; ++w) {
-    workers.emplace_back(start, state_dim, n);
-    workers.back().use_integral_action(task);
-  }
+  for (int w = 0; w < threads; ++w) workers.emplace_back(start, task);
   nn::Mlp scratch = start;
 
   // Mean objective of weights theta, with controller c (its network replaced).

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/cli.hpp"
 #include "common/config/table.hpp"
 
 namespace auvrl::task {
@@ -181,6 +182,12 @@ const config::Table<TaskConfig>& task_table() {
 const config::Table<GoalScheduleConfig>& goal_schedule_table() {
   static const config::Table<GoalScheduleConfig> table = make_schedule_table();
   return table;
+}
+
+void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s) {
+  cmd.option("integral-gain", &gain_per_s,
+             "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
+  cmd.check("integral-gain", CLI::Range(0.0, GoalIntegralSettings::kMaxGainPerS));
 }
 
 void read_task_config(config::Section s, TaskConfig& c) {

@@ -1,12 +1,22 @@
 // The `task:` and `schedule:` sections of a run configuration (config/presets/*.yaml), read
-// through their tables (task_table(), goal_schedule_table()).
+// through their tables (task_table(), goal_schedule_table()), and the task's one command-line
+// option.
 #pragma once
 
 #include "common/config/yaml_config.hpp"
 #include "common/task/goal_schedule.hpp"
 #include "common/task/task.hpp"
 
+namespace auvrl::cli {
+class CommandLine;
+}  // namespace auvrl::cli
+
 namespace auvrl::task {
+
+/// `--integral-gain PER_S` (task.integral.gain_per_s, 0: off, checked against
+/// GoalIntegralSettings::kMaxGainPerS), for the programs that drive a policy from a file
+/// (`auvrl eval`, `auvrl export`, `auv_controller`).
+void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s);
 
 /// Fills `config` from a `task:` section (keys named as the TaskConfig members; absent keys
 /// keep their values) and validates it. Throws config::ConfigError naming file and key.
