@@ -41,7 +41,8 @@ struct FinetuneConfig {
   double random_heading_fraction = 0.25;  ///< of them, starting at a random heading
   /// Of them, this share (spread through the list) also gets the conditions `randomise` draws:
   /// faults, currents, sensor noise, a wrong model; from the fine-tuning's own stream. 0: the
-  /// vehicle file's, in still water.
+  /// vehicle file's, in still water. The faults among them take the thrusters in turn (each as
+  /// often as the next), their efficiencies drawn.
   double randomised_fraction = 0.0;
   /// The fine-tuning's own randomisation (the actors' is task.randomise): TD3 can learn in still
   /// water, where it learns fastest, and the fine-tuning still see the conditions a vehicle

@@ -96,6 +96,36 @@ TEST(FinetuneEpisodes, RandomiseTheFractionAskedWithoutMovingTheWayPoints) {
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
+// The randomised way-points' faults take the thrusters in turn, each as often as the next, with
+// the efficiency drawn; with a wrong model as well, every other thruster keeps the model's thrust
+// scale.
+TEST(FinetuneEpisodes, FaultsTakeTheThrustersInTurn) {
+  FinetuneConfig c;
+  c.episodes = 36;
+  c.randomised_fraction = 0.5;
+  c.randomise.fault_probability = 1.0;
+  c.randomise.fault_efficiency = {0.0, 0.1};
+  const task::TaskConfig t = fast_task();
+  std::vector<int> faults(6, 0);
+  for (const FinetuneEpisode& e : finetune_episodes(t, c, 3)) {
+    const std::vector<double>& efficiency = e.start.thruster_efficiency;
+    if (efficiency.empty()) continue;
+    ASSERT_EQ(efficiency.size(), 6u);
+    const auto weak = std::min_element(efficiency.begin(), efficiency.end());
+    EXPECT_LE(*weak, 0.1);
+    EXPECT_EQ(std::count(efficiency.begin(), efficiency.end(), 1.0), 5);
+    ++faults[static_cast<std::size_t>(weak - efficiency.begin())];
+  }
+  EXPECT_EQ(faults, std::vector<int>(6, 3));
+  c.randomise.model_probability = 1.0;
+  c.randomise.thrust_scale = {0.7, 0.7};
+  for (const FinetuneEpisode& e : finetune_episodes(t, c, 3)) {
+    const std::vector<double>& efficiency = e.start.thruster_efficiency;
+    if (efficiency.empty()) continue;
+    EXPECT_EQ(std::count(efficiency.begin(), efficiency.end(), 0.7), 5);
+  }
+}
+
 TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   const task::TaskConfig t = fast_task();
   FinetuneEpisode e;
