@@ -53,21 +53,6 @@ void FinetuneConfig::validate() const {
   require(what.empty(), "randomise." + key + " " + what);
 }
 
-namespace {
-
-/// Moves a drawn fault (its efficiency kept) to `thruster`. The fine-tuning's few fault
-/// episodes take the thrusters in turn: drawn at random, a dozen of them over six thrusters
-/// often leave a thruster without a single fault, and the fine-tuning never learns to do
-/// without that one (docs/lab-notes/2026-11-25-dead-thrusters.md).
-void move_fault(task::EpisodeConditions& conditions, int thruster) {
-  auto& efficiency = conditions.thruster_efficiency;
-  std::swap(efficiency[static_cast<std::size_t>(conditions.fault_thruster)],
-            efficiency[static_cast<std::size_t>(thruster)]);
-  conditions.fault_thruster = thruster;
-}
-
-}  // namespace
-
 std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
                                                const FinetuneConfig& config, std::uint64_t seed) {
   // A stream of its own: the evaluation's suite draws task::sample_goal from mt19937_64(1) and
@@ -97,10 +82,13 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
     if (spread(turned, i)) {
       e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
     }
-    task::EpisodeConditions conditions =
-        task::sample_conditions(config.randomise, task.num_thrusters, conditions_rng);
+    // The faults take the thrusters in turn: drawn at random, a dozen of them over six
+    // thrusters often leave one without a single fault, and the fine-tuning never learns to do
+    // without it (docs/lab-notes/2026-11-25-dead-thrusters.md).
+    const task::EpisodeConditions conditions = task::sample_conditions(
+        config.randomise, task.num_thrusters, conditions_rng, faults % task.num_thrusters);
     if (spread(randomised, i)) {
-      if (conditions.fault_thruster >= 0) move_fault(conditions, faults++ % task.num_thrusters);
+      if (conditions.fault_thruster >= 0) ++faults;
       agent::apply_conditions(conditions, e.start);
     }
     e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
@@ -202,10 +190,8 @@ FinetuneResult finetune_policy(
     const std::function<void(const FinetuneIteration&, const nn::Mlp& weights)>& progress,
     const std::function<bool()>& stop) {
   config.validate();
-  const int n = model.num_thrusters();
-  const int state_dim = task.state_dim();
   // Throws if the network does not fit the task.
-  { agent::PolicyController check(start, state_dim, n); }
+  { agent::PolicyController check(start, task); }
   std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
   if (config.pid_lag_weight > 0) set_pid_arrivals(model, task, config, episodes);
   const auto t0 = std::chrono::steady_clock::now();

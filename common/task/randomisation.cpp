@@ -127,12 +127,18 @@ std::string describe_kinds(unsigned kinds) {
 }
 
 EpisodeConditions sample_conditions(const EpisodeRandomisation& r, int num_thrusters,
-                                    std::mt19937_64& rng) {
+                                    std::mt19937_64& rng, int fault_thruster) {
+  if (fault_thruster < -1 || fault_thruster >= num_thrusters) {
+    throw std::invalid_argument("sample_conditions: fault_thruster " +
+                                std::to_string(fault_thruster) + " of " +
+                                std::to_string(num_thrusters) + " thrusters (-1: drawn)");
+  }
   EpisodeConditions c;
   // Every number is drawn, used or not: a fixed count per episode.
   const bool fault = draw::unit(rng) < r.fault_probability;
-  const int thruster =
+  const int drawn_thruster =
       std::min(num_thrusters - 1, static_cast<int>(draw::unit(rng) * num_thrusters));
+  const int thruster = fault_thruster >= 0 ? fault_thruster : drawn_thruster;
   const double efficiency = uniform(r.fault_efficiency, rng);
 
   const bool current = draw::unit(rng) < r.current_probability;

@@ -97,8 +97,10 @@ std::string describe_kinds(unsigned kinds);
 
 /// Draws one episode's conditions for a vehicle of num_thrusters. Takes the same number of draws
 /// from rng whatever the probabilities and ranges, so that turning one kind on changes nothing
-/// that the others draw.
+/// that the others draw. fault_thruster -1: a fault, if drawn, falls on a thruster drawn
+/// uniformly; otherwise on that one (the draw still taken), so that a fixed set of episodes can
+/// take the thrusters in turn. Throws std::invalid_argument if it is not a thruster.
 EpisodeConditions sample_conditions(const EpisodeRandomisation& randomisation, int num_thrusters,
-                                    std::mt19937_64& rng);
+                                    std::mt19937_64& rng, int fault_thruster = -1);
 
 }  // namespace auvrl::task

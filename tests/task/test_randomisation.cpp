@@ -176,6 +176,25 @@ std::string refusal(const EpisodeRandomisation& r) {
   return "";
 }
 
+// A fault thruster asked for takes the fault the draw would have placed elsewhere: the same
+// kinds and efficiency, the same number of draws; one that is not a thruster is refused.
+TEST(Randomisation, AFaultCanBeGivenItsThruster) {
+  EpisodeRandomisation r;
+  r.fault_probability = 1.0;
+  std::mt19937_64 a(5), b(5);
+  for (int i = 0; i < 50; ++i) {
+    const EpisodeConditions drawn = sample_conditions(r, kThrusters, a);
+    const EpisodeConditions given = sample_conditions(r, kThrusters, b, i % kThrusters);
+    ASSERT_EQ(given.fault_thruster, i % kThrusters);
+    EXPECT_EQ(given.kinds, drawn.kinds);
+    EXPECT_EQ(given.thruster_efficiency[static_cast<std::size_t>(i % kThrusters)],
+              drawn.thruster_efficiency[static_cast<std::size_t>(drawn.fault_thruster)]);
+  }
+  EXPECT_EQ(a(), b());
+  EXPECT_THROW(sample_conditions(r, kThrusters, a, kThrusters), std::invalid_argument);
+  EXPECT_THROW(sample_conditions(r, kThrusters, a, -2), std::invalid_argument);
+}
+
 TEST(Randomisation, UnusableSettingsAreRefusedNamingTheKey) {
   EXPECT_EQ(refusal(everything()), "");
   EpisodeRandomisation r;
