@@ -79,6 +79,8 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
   t.field("episodes", &C::episodes, "way-points", "way-points the objective averages over");
   t.field("random_heading_fraction", &C::random_heading_fraction, "0..1",
           "of them, starting at a random heading");
+  t.field("facing_away_fraction", &C::facing_away_fraction, "0..1",
+          "of those, facing straight away from their way-point instead");
   t.field("randomised_fraction", &C::randomised_fraction, "0..1",
           "of them, under the conditions finetune.randomise draws (faults, currents, noise, "
           "model)");

@@ -22,6 +22,10 @@
 
 namespace auvrl::tuning {
 
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
 void FinetuneConfig::validate() const {
   auto require = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("finetune: " + what);
@@ -33,6 +37,8 @@ void FinetuneConfig::validate() const {
   require(episodes >= 1, "episodes must be >= 1");
   require(random_heading_fraction >= 0 && random_heading_fraction <= 1,
           "random_heading_fraction must be in [0, 1]");
+  require(facing_away_fraction >= 0 && facing_away_fraction <= 1,
+          "facing_away_fraction must be in [0, 1]");
   require(std::isfinite(hold_weight) && hold_weight >= 0, "hold_weight must be >= 0");
   require(hold_steps >= 1, "hold_steps must be >= 1");
   require(std::isfinite(flip_margin_rad) && flip_margin_rad > 0, "flip_margin_rad must be > 0");
@@ -69,25 +75,31 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   std::seed_seq conditions_seq{static_cast<std::uint32_t>(seed),
                                static_cast<std::uint32_t>(seed >> 32), 0xF17E7u, 0xC0D1u};
   std::mt19937_64 conditions_rng(conditions_seq);
-  const auto spread = [&](int k, int i) {
-    return k > 0 && (i * k) / config.episodes != ((i + 1) * k) / config.episodes;
-  };
+  const int facing_away = static_cast<int>(std::lround(config.facing_away_fraction * turned));
+  // Whether item i of n is one of the k spread evenly through them.
+  const auto spread = [](int k, int i, int n) { return k > 0 && (i * k) / n != ((i + 1) * k) / n; };
   int faults = 0;
+  int turned_so_far = 0;
   for (int i = 0; i < config.episodes; ++i) {
     FinetuneEpisode e;
     e.goal_ned_m = task::sample_goal(task, rng);
     e.start.position_ned_m = task.start_position_ned_m;
     e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
-    // Spread the turned starts evenly through the list.
-    if (spread(turned, i)) {
-      e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * 3.14159265358979323846;
+    if (spread(turned, i, config.episodes)) {
+      // The heading is drawn either way, so that facing away moves no other way-point.
+      e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * kPi;
+      if (spread(facing_away, turned_so_far++, turned)) {
+        const Eigen::Vector3d to_goal = e.goal_ned_m - e.start.position_ned_m;
+        e.start.euler_rpy_rad[2] =
+            std::remainder(std::atan2(to_goal.y(), to_goal.x()) + kPi, 2.0 * kPi);
+      }
     }
     // The faults take the thrusters in turn: drawn at random, a dozen of them over six
     // thrusters often leave one without a single fault, and the fine-tuning never learns to do
     // without it (docs/lab-notes/2026-11-25-dead-thrusters.md).
     const task::EpisodeConditions conditions = task::sample_conditions(
         config.randomise, task.num_thrusters, conditions_rng, faults % task.num_thrusters);
-    if (spread(randomised, i)) {
+    if (spread(randomised, i, config.episodes)) {
       if (conditions.fault_thruster >= 0) ++faults;
       agent::apply_conditions(conditions, e.start);
     }

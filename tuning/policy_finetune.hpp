@@ -39,6 +39,10 @@ struct FinetuneConfig {
   double learning_rate = 0.01;  ///< Adam's step on the rank-weighted direction
   int episodes = 24;            ///< way-points the objective averages over (fixed for the run)
   double random_heading_fraction = 0.25;  ///< of them, starting at a random heading
+  /// Of those turned starts, this share (spread through them) face straight away from their
+  /// way-point instead: the start where a policy must choose which way to turn, and one that
+  /// has not learnt to may back towards the way-point for seconds before it does.
+  double facing_away_fraction = 0.0;
   /// Of them, this share (spread through the list) also gets the conditions `randomise` draws:
   /// faults, currents, sensor noise, a wrong model; from the fine-tuning's own stream. 0: the
   /// vehicle file's, in still water. The faults among them take the thrusters in turn (each as

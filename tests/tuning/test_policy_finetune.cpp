@@ -64,6 +64,33 @@ TEST(FinetuneEpisodes, AreDeterministicInTheRegionAndTurnTheFractionAsked) {
   for (const auto& e : a) EXPECT_NE(e.goal_ned_m, first_suite_goal);
 }
 
+// facing_away_fraction: that share of the turned starts faces straight away from its
+// way-point (in the horizontal plane); every way-point and the other headings stay.
+TEST(FinetuneEpisodes, FaceAwayFromTheirWayPointsTheShareOfTurnedStartsAsked) {
+  FinetuneConfig c;
+  c.episodes = 24;
+  c.random_heading_fraction = 0.5;
+  const task::TaskConfig t = fast_task();
+  const auto drawn = finetune_episodes(t, c, 3);
+  c.facing_away_fraction = 0.5;
+  const auto away = finetune_episodes(t, c, 3);
+  ASSERT_EQ(away.size(), drawn.size());
+  int facing_away = 0, turned = 0;
+  for (std::size_t i = 0; i < away.size(); ++i) {
+    EXPECT_EQ(away[i].goal_ned_m, drawn[i].goal_ned_m);
+    const double yaw = away[i].start.euler_rpy_rad[2];
+    if (drawn[i].start.euler_rpy_rad[2] != t.start_yaw_rad) ++turned;
+    if (yaw == drawn[i].start.euler_rpy_rad[2]) continue;
+    ++facing_away;
+    const Eigen::Vector3d to_goal = away[i].goal_ned_m - away[i].start.position_ned_m;
+    const Eigen::Vector2d heading(std::cos(yaw), std::sin(yaw));
+    EXPECT_NEAR(heading.dot(to_goal.head<2>().normalized()), -1.0, 1e-12) << "way-point " << i;
+    EXPECT_LE(std::abs(yaw), 3.14159265358979323846);
+  }
+  EXPECT_EQ(turned, 12);
+  EXPECT_EQ(facing_away, 6);
+}
+
 // randomised_fraction: that share of the way-points gets the conditions finetune.randomise draws
 // (every kind on here, so each randomised episode gets a fault), the way-points and headings
 // unchanged; the task's own randomisation (the actors') does not reach them.
@@ -358,6 +385,7 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
        {+[](FinetuneConfig& f) { f.pairs = 0; }, +[](FinetuneConfig& f) { f.episodes = 0; },
         +[](FinetuneConfig& f) { f.learning_rate = -1; },
         +[](FinetuneConfig& f) { f.random_heading_fraction = 2; },
+        +[](FinetuneConfig& f) { f.facing_away_fraction = -0.1; },
         +[](FinetuneConfig& f) { f.hold_steps = 0; },
         +[](FinetuneConfig& f) { f.integration_substeps = -1; },
         +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
