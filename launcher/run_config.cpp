@@ -81,6 +81,8 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "of them, starting at a random heading");
   t.field("facing_away_fraction", &C::facing_away_fraction, "0..1",
           "of those, facing straight away from their way-point instead");
+  t.field("any_start_fraction", &C::any_start_fraction, "0..1",
+          "of them, starting at rest anywhere in the way-points' region");
   t.field("randomised_fraction", &C::randomised_fraction, "0..1",
           "of them, under the conditions finetune.randomise draws (faults, currents, noise, "
           "model)");

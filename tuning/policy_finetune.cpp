@@ -19,11 +19,26 @@
 #include "common/nn/adam.hpp"
 #include "common/nn/random.hpp"
 #include "common/random.hpp"
+#include "eval/robustness.hpp"
 
 namespace auvrl::tuning {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
+/// A position drawn uniformly in the way-points' region, at least the robustness suite's minimum
+/// distance from the goal (a few redraws at most: a region of any use has room beyond 1 m).
+Eigen::Vector3d region_start(const task::TaskConfig& task, const Eigen::Vector3d& goal_ned_m,
+                             std::mt19937_64& rng) {
+  Eigen::Vector3d p = task.start_position_ned_m;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    for (int k = 0; k < 3; ++k) {
+      p[k] = task.goal_min_ned_m[k] +
+             (task.goal_max_ned_m[k] - task.goal_min_ned_m[k]) * draw::unit(rng);
+    }
+    if ((goal_ned_m - p).norm() >= eval::kRobustnessMinGoalDistanceM) break;
+  }
+  return p;
+}
 }  // namespace
 
 void FinetuneConfig::validate() const {
@@ -39,6 +54,8 @@ void FinetuneConfig::validate() const {
           "random_heading_fraction must be in [0, 1]");
   require(facing_away_fraction >= 0 && facing_away_fraction <= 1,
           "facing_away_fraction must be in [0, 1]");
+  require(any_start_fraction >= 0 && any_start_fraction <= 1,
+          "any_start_fraction must be in [0, 1]");
   require(std::isfinite(hold_weight) && hold_weight >= 0, "hold_weight must be >= 0");
   require(hold_steps >= 1, "hold_steps must be >= 1");
   require(std::isfinite(flip_margin_rad) && flip_margin_rad > 0, "flip_margin_rad must be > 0");
@@ -75,6 +92,11 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   std::seed_seq conditions_seq{static_cast<std::uint32_t>(seed),
                                static_cast<std::uint32_t>(seed >> 32), 0xF17E7u, 0xC0D1u};
   std::mt19937_64 conditions_rng(conditions_seq);
+  // The starts' own stream, drawn for every way-point: moving them moves nothing else.
+  std::seed_seq starts_seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                           0xF17E7u, 0x57A7u};
+  std::mt19937_64 starts_rng(starts_seq);
+  const int any_start = static_cast<int>(std::lround(config.any_start_fraction * config.episodes));
   const int facing_away = static_cast<int>(std::lround(config.facing_away_fraction * turned));
   // Whether item i of n is one of the k spread evenly through them.
   const auto spread = [](int k, int i, int n) { return k > 0 && (i * k) / n != ((i + 1) * k) / n; };
@@ -85,6 +107,11 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
     e.goal_ned_m = task::sample_goal(task, rng);
     e.start.position_ned_m = task.start_position_ned_m;
     e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
+    const Eigen::Vector3d anywhere_ned_m = region_start(task, e.goal_ned_m, starts_rng);
+    if (spread(any_start, i, config.episodes)) {
+      e.start.position_ned_m = anywhere_ned_m;
+      e.safety_radius_m = (e.goal_ned_m - anywhere_ned_m).norm() + task.beta_max_m;
+    }
     if (spread(turned, i, config.episodes)) {
       // The heading is drawn either way, so that facing away moves no other way-point.
       e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * kPi;
@@ -147,6 +174,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   task::TaskConfig t = task;
   task::apply_vehicle(plant.facts(), t);
   t.max_steps = config.episode_steps;
+  if (episode.safety_radius_m > 0.0) t.beta_max_m = episode.safety_radius_m;
   // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
   agent::EpisodeOptions options;
   options.goal_ned_m = episode.goal_ned_m;

@@ -43,6 +43,12 @@ struct FinetuneConfig {
   /// way-point instead: the start where a policy must choose which way to turn, and one that
   /// has not learnt to may back towards the way-point for seconds before it does.
   double facing_away_fraction = 0.0;
+  /// Of them, this share (spread through the list) starts at rest anywhere in the way-points'
+  /// region instead of at the task's start (as the robustness suite's any_start group and a
+  /// mission's later legs do), from a stream of its own, at least 1 m from its way-point; the
+  /// safety sphere grows by the start's distance, as the suite's does. The fixed start never
+  /// shows a climb or dive of more than 4 m.
+  double any_start_fraction = 0.0;
   /// Of them, this share (spread through the list) also gets the conditions `randomise` draws:
   /// faults, currents, sensor noise, a wrong model; from the fine-tuning's own stream. 0: the
   /// vehicle file's, in still water. The faults among them take the thrusters in turn (each as
@@ -99,6 +105,8 @@ struct FinetuneEpisode {
   /// The PID baseline's objective with only the arrival priced (set_pid_arrivals), s; NaN:
   /// none, and no lag term.
   double pid_arrival_s = std::numeric_limits<double>::quiet_NaN();
+  /// The episode's safety sphere around the way-point, m (0: the task's beta_max_m).
+  double safety_radius_m = 0.0;
 };
 
 /// The objective's way-points for a run seed (see the file comment).

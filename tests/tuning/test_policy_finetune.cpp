@@ -91,6 +91,36 @@ TEST(FinetuneEpisodes, FaceAwayFromTheirWayPointsTheShareOfTurnedStartsAsked) {
   EXPECT_EQ(facing_away, 6);
 }
 
+// any_start_fraction: that share starts at rest anywhere in the way-points' region, at least
+// 1 m from its way-point, with the safety sphere grown by its distance; the way-points stay.
+TEST(FinetuneEpisodes, StartAnywhereInTheRegionTheShareAsked) {
+  FinetuneConfig c;
+  c.episodes = 20;
+  const task::TaskConfig t = fast_task();
+  const auto fixed = finetune_episodes(t, c, 4);
+  c.any_start_fraction = 0.25;
+  const auto anywhere = finetune_episodes(t, c, 4);
+  ASSERT_EQ(anywhere.size(), fixed.size());
+  int moved = 0;
+  for (std::size_t i = 0; i < anywhere.size(); ++i) {
+    const FinetuneEpisode& e = anywhere[i];
+    EXPECT_EQ(e.goal_ned_m, fixed[i].goal_ned_m);
+    if (e.start.position_ned_m == t.start_position_ned_m) {
+      EXPECT_EQ(e.safety_radius_m, 0.0);
+      continue;
+    }
+    ++moved;
+    const double distance_m = (e.goal_ned_m - e.start.position_ned_m).norm();
+    EXPECT_GE(distance_m, 1.0);
+    EXPECT_DOUBLE_EQ(e.safety_radius_m, distance_m + t.beta_max_m);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(e.start.position_ned_m[k], t.goal_min_ned_m[k]);
+      EXPECT_LE(e.start.position_ned_m[k], t.goal_max_ned_m[k]);
+    }
+  }
+  EXPECT_EQ(moved, 5);
+}
+
 // randomised_fraction: that share of the way-points gets the conditions finetune.randomise draws
 // (every kind on here, so each randomised episode gets a fault), the way-points and headings
 // unchanged; the task's own randomisation (the actors') does not reach them.
@@ -264,6 +294,25 @@ TEST(ArrivalObjective, NotArrivingCostsTheEpisodeTimePlusTheClosestApproach) {
   EXPECT_NEAR(j, 5.0 + 5.0, 0.05) << "the vehicle barely drifts (1 N buoyant)";
 }
 
+// A way-point farther than the task's safety sphere (20 m) from its start: the episode's own
+// sphere lets the policy get there; without it the episode ends at once, as a failure.
+TEST(ArrivalObjective, AnEpisodesSafetySphereReplacesTheTasks) {
+  FinetuneEpisode e;
+  e.start.position_ned_m = Eigen::Vector3d(-10.0, -10.0, 5.0);
+  e.goal_ned_m = Eigen::Vector3d(8.0, 8.0, 5.0);  // 25.5 m ahead
+  e.start.euler_rpy_rad[2] = 0.785398;
+  FinetuneConfig c;
+  c.episode_steps = 400;
+  c.hold_steps = 10;
+  const nn::Mlp policy = committed_policy();
+  agent::PolicyController controller(policy, fast_task().state_dim(), 6);
+  const double failed = arrival_objective(nessie(), fast_task(), controller, e, c);
+  EXPECT_NEAR(failed, 40.0 + 25.5, 0.1) << "the episode's time plus the closest approach";
+  e.safety_radius_m = 25.5 + 20.0;
+  const double arrived = arrival_objective(nessie(), fast_task(), controller, e, c);
+  EXPECT_LT(arrived, 30.0);
+}
+
 TEST(ArrivalObjective, ACoarserIntegratorGivesTheSameObjectiveForATrainedPolicy) {
   // The fine-tuning's episodes may run RK4 with fewer steps than the vehicle file's 10 (the
   // fast preset runs 2): the policy's objective must not move with it, or the fine-tuning
@@ -386,6 +435,7 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.learning_rate = -1; },
         +[](FinetuneConfig& f) { f.random_heading_fraction = 2; },
         +[](FinetuneConfig& f) { f.facing_away_fraction = -0.1; },
+        +[](FinetuneConfig& f) { f.any_start_fraction = 1.5; },
         +[](FinetuneConfig& f) { f.hold_steps = 0; },
         +[](FinetuneConfig& f) { f.integration_substeps = -1; },
         +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
