@@ -31,10 +31,7 @@ Eigen::Vector3d region_start(const task::TaskConfig& task, const Eigen::Vector3d
                              std::mt19937_64& rng) {
   Eigen::Vector3d p = task.start_position_ned_m;
   for (int attempt = 0; attempt < 100; ++attempt) {
-    for (int k = 0; k < 3; ++k) {
-      p[k] = task.goal_min_ned_m[k] +
-             (task.goal_max_ned_m[k] - task.goal_min_ned_m[k]) * draw::unit(rng);
-    }
+    p = task::sample_goal(task, rng);  // a point of the way-points' region
     if ((goal_ned_m - p).norm() >= eval::kRobustnessMinGoalDistanceM) break;
   }
   return p;
