@@ -46,8 +46,9 @@ struct FinetuneConfig {
   /// Of them, this share (spread through the list) starts at rest anywhere in the way-points'
   /// region instead of at the task's start (as the robustness suite's any_start group and a
   /// mission's later legs do), from a stream of its own, at least 1 m from its way-point; the
-  /// safety sphere grows by the start's distance, as the suite's does. The fixed start never
-  /// shows a climb or dive of more than 4 m.
+  /// safety sphere grows by the start's distance, as the suite's does. The fixed start shows
+  /// only the climbs and dives the region allows from there (the fast preset's: climbs of 4 m
+  /// at most).
   double any_start_fraction = 0.0;
   /// Of them, this share (spread through the list) also gets the conditions `randomise` draws:
   /// faults, currents, sensor noise, a wrong model; from the fine-tuning's own stream. 0: the
