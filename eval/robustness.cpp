@@ -152,8 +152,7 @@ EvaluationEpisode draw_episode(const EvaluationConfig& config, int num_thrusters
   draw_start(config.task, g.draw.start, yaw_rad, rng, e.start);
   draw_goal(config.task, g.draw.goal, rng, e);
   if (g.draw.start == StartDraw::kAnywhere || g.draw.goal == GoalDraw::kFar) {
-    // The start may lie beyond the safety sphere (20 m): it grows by the start's distance.
-    e.safety_radius_m = (e.goal_ned_m - e.start.position_ned_m).norm() + config.task.beta_max_m;
+    e.safety_radius_m = grown_safety_radius_m(config.task, e.start.position_ned_m, e.goal_ned_m);
   }
   draw_conditions(g.draw, num_thrusters, rng, e.start);
   e.start.seed = rng();
@@ -174,6 +173,11 @@ void cell_or_empty(csv::Writer& out, double value) {
 }
 
 }  // namespace
+
+double grown_safety_radius_m(const task::TaskConfig& task, const Eigen::Vector3d& start_ned_m,
+                             const Eigen::Vector3d& goal_ned_m) {
+  return (goal_ned_m - start_ned_m).norm() + task.beta_max_m;
+}
 
 std::vector<RobustnessGroup> robustness_groups(int num_thrusters,
                                                const std::vector<std::string>& thruster_names) {

@@ -70,6 +70,10 @@ namespace auvrl::eval {
 constexpr int kRobustnessEpisodesPerGroup = 20;
 /// A drawn way-point closer than this to the start (m) is drawn again.
 constexpr double kRobustnessMinGoalDistanceM = 1.0;
+/// The safety sphere of an episode whose start may lie beyond the task's (beta_max_m around the
+/// way-point): it grows by the start's distance from the way-point, m.
+double grown_safety_radius_m(const task::TaskConfig& task, const Eigen::Vector3d& start_ned_m,
+                             const Eigen::Vector3d& goal_ned_m);
 /// The farthest way-point of far_waypoint, m.
 constexpr double kRobustnessFarMaxM = 30.0;
 

@@ -29,12 +29,21 @@ constexpr double kPi = 3.14159265358979323846;
 /// distance from the goal (a few redraws at most: a region of any use has room beyond 1 m).
 Eigen::Vector3d region_start(const task::TaskConfig& task, const Eigen::Vector3d& goal_ned_m,
                              std::mt19937_64& rng) {
-  Eigen::Vector3d p = task.start_position_ned_m;
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    p = task::sample_goal(task, rng);  // a point of the way-points' region
-    if ((goal_ned_m - p).norm() >= eval::kRobustnessMinGoalDistanceM) break;
+  Eigen::Vector3d p = task::sample_goal(task, rng);  // a point of the way-points' region
+  for (int attempt = 1;
+       attempt < 100 && (goal_ned_m - p).norm() < eval::kRobustnessMinGoalDistanceM; ++attempt) {
+    p = task::sample_goal(task, rng);
   }
   return p;
+}
+
+/// One of the fine-tuning's random streams: the run seed mixed with the stream's own tag, so that
+/// each kind of draw stays apart from the others, from the evaluation suite's (mt19937_64(1))
+/// and from the launcher's validation.
+std::mt19937_64 finetune_stream(std::uint64_t seed, std::uint32_t tag) {
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    0xF17E7u, tag};
+  return std::mt19937_64(seq);
 }
 }  // namespace
 
@@ -75,24 +84,16 @@ void FinetuneConfig::validate() const {
 
 std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
                                                const FinetuneConfig& config, std::uint64_t seed) {
-  // A stream of its own: the evaluation's suite draws task::sample_goal from mt19937_64(1) and
-  // the launcher's validation from its own seed; mixing the run seed keeps them apart.
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    0xF17E7u, 0x5EEDu};
-  std::mt19937_64 rng(seq);
+  std::mt19937_64 rng = finetune_stream(seed, 0x5EEDu);  // way-points and headings
   std::vector<FinetuneEpisode> episodes;
   const int turned =
       static_cast<int>(std::lround(config.random_heading_fraction * config.episodes));
   const int randomised =
       static_cast<int>(std::lround(config.randomised_fraction * config.episodes));
-  // The conditions' own stream: turning them on changes no way-point or heading.
-  std::seed_seq conditions_seq{static_cast<std::uint32_t>(seed),
-                               static_cast<std::uint32_t>(seed >> 32), 0xF17E7u, 0xC0D1u};
-  std::mt19937_64 conditions_rng(conditions_seq);
-  // The starts' own stream, drawn for every way-point: moving them moves nothing else.
-  std::seed_seq starts_seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                           0xF17E7u, 0x57A7u};
-  std::mt19937_64 starts_rng(starts_seq);
+  // The conditions' and the starts' own streams, drawn for every way-point: turning them on
+  // changes no way-point or heading.
+  std::mt19937_64 conditions_rng = finetune_stream(seed, 0xC0D1u);
+  std::mt19937_64 starts_rng = finetune_stream(seed, 0x57A7u);
   const int any_start = static_cast<int>(std::lround(config.any_start_fraction * config.episodes));
   const int facing_away = static_cast<int>(std::lround(config.facing_away_fraction * turned));
   // Whether item i of n is one of the k spread evenly through them.
@@ -107,7 +108,7 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
     const Eigen::Vector3d anywhere_ned_m = region_start(task, e.goal_ned_m, starts_rng);
     if (spread(any_start, i, config.episodes)) {
       e.start.position_ned_m = anywhere_ned_m;
-      e.safety_radius_m = (e.goal_ned_m - anywhere_ned_m).norm() + task.beta_max_m;
+      e.safety_radius_m = eval::grown_safety_radius_m(task, anywhere_ned_m, e.goal_ned_m);
     }
     if (spread(turned, i, config.episodes)) {
       // The heading is drawn either way, so that facing away moves no other way-point.
