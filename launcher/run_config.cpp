@@ -54,6 +54,9 @@ void add_objective_fields(config::Table<tuning::FinetuneConfig>& t) {
   t.field("hold_weight", &C::hold_weight, "s per m",
           "weight of the mean distance over the arrival and hold_steps after it");
   t.field("hold_steps", &C::hold_steps, "steps", "steps of holding the objective prices");
+  t.field("hold_turn_weight", &C::hold_turn_weight, "s per rad/s",
+          "price of the heading's net change over the same steps, per second (turning on the "
+          "spot)");
   t.field("flip_margin_rad", &C::flip_margin_rad, "rad",
           "|roll| or |pitch| beyond this costs flip_margin_weight");
   t.field("flip_margin_weight", &C::flip_margin_weight, "s per rad", "see flip_margin_rad");

@@ -64,6 +64,8 @@ void FinetuneConfig::validate() const {
           "any_start_fraction must be in [0, 1]");
   require(std::isfinite(hold_weight) && hold_weight >= 0, "hold_weight must be >= 0");
   require(hold_steps >= 1, "hold_steps must be >= 1");
+  require(std::isfinite(hold_turn_weight) && hold_turn_weight >= 0,
+          "hold_turn_weight must be >= 0");
   require(std::isfinite(flip_margin_rad) && flip_margin_rad > 0, "flip_margin_rad must be > 0");
   require(std::isfinite(flip_margin_weight) && flip_margin_weight >= 0,
           "flip_margin_weight must be >= 0");
@@ -140,6 +142,7 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
   // arriving, the episode's time plus the closest approach).
   FinetuneConfig arrival_only = config;
   arrival_only.hold_weight = 0.0;
+  arrival_only.hold_turn_weight = 0.0;
   arrival_only.flip_margin_weight = 0.0;
   arrival_only.energy_weight = 0.0;
   arrival_only.smoothness_weight = 0.0;
@@ -214,9 +217,18 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
     const double fraction = before > d ? (before - reach_radius_m) / (before - d) : 1.0;
     const double arrival_s = (static_cast<double>(k) + std::clamp(fraction, 0.0, 1.0)) * dt;
     double sum_m = 0.0;
-    for (std::size_t j = k; j < trajectory.size(); ++j) sum_m += trajectory[j].distance_m;
+    double turn_rad = 0.0;  // the heading's net change, unwrapped
+    for (std::size_t j = k; j < trajectory.size(); ++j) {
+      sum_m += trajectory[j].distance_m;
+      if (j == k) continue;
+      const double yaw_rad = trajectory[j].observation.euler_rpy_rad[2];
+      turn_rad +=
+          std::remainder(yaw_rad - trajectory[j - 1].observation.euler_rpy_rad[2], 2.0 * kPi);
+    }
     const auto n = static_cast<double>(trajectory.size() - k);
-    return arrival_s + config.hold_weight * sum_m / n + margin_s + lag_s(arrival_s);
+    // hold_turn_weight x the net turn per second of the hold.
+    return arrival_s + config.hold_weight * sum_m / n +
+           config.hold_turn_weight * std::abs(turn_rad) / (n * dt) + margin_s + lag_s(arrival_s);
   }
   const double give_up_s = config.episode_steps * dt;
   return give_up_s + closest_m + margin_s + lag_s(give_up_s);

@@ -65,6 +65,13 @@ struct FinetuneConfig {
   /// after it (s per m); the episode ends there.
   double hold_weight = 2.0;
   int hold_steps = 150;
+  /// Plus hold_turn_weight s per rad/s of the heading's net change over the same steps, per
+  /// second of them. The task gives no heading to hold, and a trained policy may turn slowly
+  /// on the spot while it holds; against a current the push then goes round in its frame from
+  /// one pair of thrusters to the other, and it drifts off while they change over (a PID
+  /// holds its heading). The net change, not the mean yaw rate: small corrections either way
+  /// cost nothing, so that the policy need not chase noise on the measured rates.
+  double hold_turn_weight = 0.0;
   /// Plus flip_margin_weight s per rad that |roll| or |pitch| ever exceeds flip_margin_rad:
   /// the rank-weighted steps otherwise learn to pitch ever further nose-down (surge then
   /// helps the slow heave), until a steep dive the few way-points did not include flips the

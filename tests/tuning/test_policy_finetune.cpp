@@ -209,6 +209,59 @@ TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   EXPECT_LT(with_hold, arrival_s + 2.0 * 0.5);
 }
 
+/// Turns the vehicle on the spot: the two surge thrusters push opposite ways, a pure yaw
+/// moment (0.37 m between them).
+class TurnOnTheSpot final : public agent::Controller {
+ public:
+  explicit TurnOnTheSpot(float command) : command_(command) {}
+  void act(const task::Observation&, const Eigen::Vector3d&, const task::StateVector&,
+           task::ActionVector& action) override {
+    action.setZero(6);
+    action[0] = command_;
+    action[1] = -command_;
+  }
+  std::string name() const override { return "turn_on_the_spot"; }
+
+ private:
+  float command_;
+};
+
+TEST(ArrivalObjective, PricesTurningOnTheSpotWhileHolding) {
+  FinetuneEpisode e;
+  e.start.position_ned_m = fast_task().start_position_ned_m;
+  e.goal_ned_m = e.start.position_ned_m;  // there from the first step: all of it is the hold
+  FinetuneConfig c;
+  c.hold_steps = 100;
+  auto objective = [&](agent::Controller& controller, double weight) {
+    c.hold_turn_weight = weight;
+    return arrival_objective(nessie(), fast_task(), controller, e, c);
+  };
+  TurnOnTheSpot still(0.0f), turning(0.3f);
+  EXPECT_NEAR(objective(still, 10.0), objective(still, 0.0), 1e-9) << "it never turns";
+  // 0.3 of full thrust each way: about 4.4 N m; Nessie turns at up to ~0.6 rad/s.
+  const double price_s = objective(turning, 10.0) - objective(turning, 0.0);
+  EXPECT_GT(price_s, 10.0 * 0.05);
+  EXPECT_LT(price_s, 10.0 * 0.6);
+  EXPECT_NEAR(objective(turning, 20.0) - objective(turning, 0.0), 2.0 * price_s, 1e-9);
+  // Turning one way and back again costs next to nothing: only the net change counts. The
+  // moment one way for 2 s, the other way for 4 s, then the first way for 2 s again leaves the
+  // vehicle about where it started, turning no more, over each 8 s.
+  struct ThereAndBack final : agent::Controller {
+    int step = 0;
+    TurnOnTheSpot one_way{0.3f}, other_way{-0.3f};
+    void reset() override { step = 0; }
+    void act(const task::Observation& o, const Eigen::Vector3d& goal, const task::StateVector& x,
+             task::ActionVector& action) override {
+      const int phase = step++ % 80;
+      (phase < 20 || phase >= 60 ? one_way : other_way).act(o, goal, x, action);
+    }
+    std::string name() const override { return "there_and_back"; }
+  } there_and_back;
+  c.hold_steps = 160;
+  const double back_price_s = objective(there_and_back, 10.0) - objective(there_and_back, 0.0);
+  EXPECT_LT(back_price_s, 0.25 * price_s);
+}
+
 TEST(ArrivalObjective, ChargesTheLagBehindThePidArrivalLessTheLead) {
   const task::TaskConfig t = fast_task();
   FinetuneConfig c;
@@ -437,6 +490,7 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.facing_away_fraction = -0.1; },
         +[](FinetuneConfig& f) { f.any_start_fraction = 1.5; },
         +[](FinetuneConfig& f) { f.hold_steps = 0; },
+        +[](FinetuneConfig& f) { f.hold_turn_weight = -1; },
         +[](FinetuneConfig& f) { f.integration_substeps = -1; },
         +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
         +[](FinetuneConfig& f) { f.pid_lead_s = std::numeric_limits<double>::infinity(); },
