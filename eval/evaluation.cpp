@@ -119,12 +119,10 @@ std::vector<EvaluationEpisode> scenario_episodes(const EvaluationConfig& config,
   switch (scenario) {
     case Scenario::kTest1:
       return {base};
-    case Scenario::kTest2: {
-      double yaw = bearing_rad + kPi;
-      if (yaw > kPi) yaw -= 2.0 * kPi;
-      base.start.euler_rpy_rad[2] = yaw;
+    case Scenario::kTest2:
+      base.start.euler_rpy_rad[2] =
+          task::yaw_facing_away_rad(base.start.position_ned_m, base.goal_ned_m);
       return {base};
-    }
     case Scenario::kFault:
       if (config.fault_thruster < 0 || config.fault_thruster >= task.num_thrusters) {
         throw std::invalid_argument("evaluation: fault thruster index " +

@@ -116,9 +116,7 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
       // The heading is drawn either way, so that facing away moves no other way-point.
       e.start.euler_rpy_rad[2] = (2.0 * draw::unit(rng) - 1.0) * kPi;
       if (spread(facing_away, turned_so_far++, turned)) {
-        const Eigen::Vector3d to_goal = e.goal_ned_m - e.start.position_ned_m;
-        e.start.euler_rpy_rad[2] =
-            std::remainder(std::atan2(to_goal.y(), to_goal.x()) + kPi, 2.0 * kPi);
+        e.start.euler_rpy_rad[2] = task::yaw_facing_away_rad(e.start.position_ned_m, e.goal_ned_m);
       }
     }
     // The faults take the thrusters in turn: drawn at random, a dozen of them over six

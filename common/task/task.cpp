@@ -122,6 +122,12 @@ Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& e) {
   return r;
 }
 
+double yaw_facing_away_rad(const Eigen::Vector3d& position_ned_m,
+                           const Eigen::Vector3d& goal_ned_m) {
+  const Eigen::Vector3d to_goal = goal_ned_m - position_ned_m;
+  return std::remainder(std::atan2(to_goal.y(), to_goal.x()) + kPi, 2.0 * kPi);
+}
+
 void build_state(const TaskConfig& c, const Observation& obs, const Eigen::Vector3d& goal,
                  const ActionVector& previous_action, StateVector& out,
                  const std::vector<double>& thrust_realised_n) {

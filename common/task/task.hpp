@@ -178,6 +178,12 @@ using ActionVector = Eigen::VectorXf;  ///< normalised commands in [-1, 1]
 /// Rotation from body to NED for ZYX Euler angles (Fossen's R(Theta)).
 Eigen::Matrix3d body_to_ned(const Eigen::Vector3d& euler_rpy_rad);
 
+/// The heading (yaw, rad, in (-pi, pi]) that faces straight away from goal_ned_m at
+/// position_ned_m, in the horizontal plane: the way-point lies exactly behind (the paper's test2,
+/// the fine-tuning's facing-away starts).
+double yaw_facing_away_rad(const Eigen::Vector3d& position_ned_m,
+                           const Eigen::Vector3d& goal_ned_m);
+
 /// The observation vector for the layout (size config.state_dim()). thrust_realised_n (N, one
 /// per thruster) is read by the extended_thrust layout only, which requires it.
 void build_state(const TaskConfig& config, const Observation& obs,
