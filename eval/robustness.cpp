@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -379,6 +380,114 @@ std::string robustness_comparison_markdown(const std::vector<GroupComparison>& c
   return out;
 }
 
+PairedDifference bootstrap_mean(const std::vector<double>& differences, std::uint64_t seed,
+                                int resamples) {
+  if (resamples < 100) {
+    throw std::invalid_argument("bootstrap_mean: at least 100 resamples, got " +
+                                std::to_string(resamples));
+  }
+  PairedDifference out;
+  out.pairs = static_cast<int>(differences.size());
+  if (differences.empty()) return out;
+  double sum = 0.0;
+  for (double d : differences) {
+    if (!std::isfinite(d)) throw std::invalid_argument("bootstrap_mean: a non-finite difference");
+    sum += d;
+  }
+  const std::size_t n = differences.size();
+  out.mean = sum / static_cast<double>(n);
+  draw::Engine rng(seed);
+  std::vector<double> means(static_cast<std::size_t>(resamples));
+  for (double& m : means) {
+    double s = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto k = std::min(n - 1, static_cast<std::size_t>(draw::unit(rng) * n));
+      s += differences[k];
+    }
+    m = s / static_cast<double>(n);
+  }
+  std::sort(means.begin(), means.end());
+  // Nearest-rank percentiles; the interval always holds the mean (it may not, by rounding, when
+  // every difference is the same).
+  const auto rank = [&](double q) {
+    return means[std::min(means.size() - 1, static_cast<std::size_t>(q * means.size()))];
+  };
+  out.low = std::min(out.mean, rank(0.025));
+  out.high = std::max(out.mean, rank(0.975));
+  return out;
+}
+
+std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
+                                         const std::vector<SummaryRow>& reference,
+                                         std::uint64_t seed, const RobustnessBar& bar) {
+  std::map<std::pair<std::string, int>, const SummaryRow*> by_episode;
+  for (const SummaryRow& r : reference) by_episode[{r.scenario, r.episode}] = &r;
+  struct Differences {
+    int held_policy_only = 0;
+    int held_reference_only = 0;
+    std::vector<double> time_s, energy, hold_m, smoothness;
+  };
+  std::vector<std::string> order;
+  std::map<std::string, Differences> groups;
+  for (const SummaryRow& p : policy) {
+    const auto found = by_episode.find({p.scenario, p.episode});
+    if (found == by_episode.end()) {
+      throw std::invalid_argument("paired_margins: group " + p.scenario + " episode " +
+                                  std::to_string(p.episode) + " has no reference row");
+    }
+    const SummaryRow& r = *found->second;
+    if (groups.find(p.scenario) == groups.end()) order.push_back(p.scenario);
+    Differences& d = groups[p.scenario];
+    d.held_policy_only += is_held(p) && !is_held(r) ? 1 : 0;
+    d.held_reference_only += is_held(r) && !is_held(p) ? 1 : 0;
+    if (p.reached && r.reached) {
+      d.time_s.push_back(p.time_to_reach_s - r.time_to_reach_s);
+      d.hold_m.push_back(p.mean_error_after_reach_m - r.mean_error_after_reach_m -
+                         bar.hold_margin_m);
+    }
+    d.energy.push_back(p.thrust_energy - r.thrust_energy);
+    d.smoothness.push_back(p.smoothness - bar.smoothness_ratio * r.smoothness);
+  }
+  std::vector<GroupMargins> out;
+  for (const std::string& name : order) {
+    const Differences& d = groups[name];
+    // Each criterion its own stream, so that one criterion's pairs move no other's interval.
+    out.push_back({name, d.held_policy_only, d.held_reference_only, bootstrap_mean(d.time_s, seed),
+                   bootstrap_mean(d.energy, seed + 1), bootstrap_mean(d.hold_m, seed + 2),
+                   bootstrap_mean(d.smoothness, seed + 3)});
+  }
+  return out;
+}
+
+std::string robustness_margins_markdown(const std::vector<GroupMargins>& margins,
+                                        const RobustnessBar& bar) {
+  const auto cell = [](const PairedDifference& d, int digits) {
+    if (d.pairs == 0) return std::string("-");
+    const std::string text =
+        fmt::format("{:+.{}f} [{:+.{}f}, {:+.{}f}]", d.mean, digits, d.low, digits, d.high, digits);
+    // Bold: the whole interval on the wrong side of the threshold.
+    return d.low > 0 ? "**" + text + "**" : text;
+  };
+  std::string out = fmt::format(
+      "| group | held by one only: policy / PID | time to reach [s] | thrust energy | hold error "
+      "[m] (+{:g}) | smoothness (x{:g}) |\n|---|---|---|---|---|---|\n",
+      bar.hold_margin_m, bar.smoothness_ratio);
+  for (const GroupMargins& m : margins) {
+    out += fmt::format("| {} | {} / {} | {} | {} | {} | {} |\n", m.group, m.held_policy_only,
+                       m.held_reference_only, cell(m.time_s, 2), cell(m.energy, 1),
+                       cell(m.hold_m, 3), cell(m.smoothness, 4));
+  }
+  out += fmt::format(
+      "\nHow sure each criterion is. Held by one only: the episodes that one controller held and "
+      "the other did not. Then, episode by episode of the same draw, the policy minus the "
+      "bar's threshold (time and energy: the PID's; hold error: the PID's plus {:g} m, episodes "
+      "both reached; smoothness: {:g} times the PID's), the group's mean and its 95 % bootstrap "
+      "interval. Negative is on the bar's side; bold, the whole interval on the other; an "
+      "interval that spans 0 means the group's episodes do not settle that criterion.\n",
+      bar.hold_margin_m, bar.smoothness_ratio);
+  return out;
+}
+
 RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
                                 agent::Controller& controller, int episodes_per_group,
                                 std::uint64_t seed, const std::string& out_dir) {
@@ -534,8 +643,10 @@ void write_robustness_csv(const std::string& path, const std::vector<GroupMetric
 }
 
 std::string write_robustness_comparison(const std::string& path,
-                                        const std::vector<GroupComparison>& comparisons) {
-  const std::string table = robustness_comparison_markdown(comparisons);
+                                        const std::vector<GroupComparison>& comparisons,
+                                        const std::vector<GroupMargins>& margins) {
+  std::string table = robustness_comparison_markdown(comparisons);
+  if (!margins.empty()) table += "\n" + robustness_margins_markdown(margins);
   std::ofstream file(path);
   file << table;
   file.flush();
@@ -605,7 +716,8 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
     const std::string path =
         (std::filesystem::path(request.out_dir) / "robustness_comparison.md").string();
     out << "\n"
-        << write_robustness_comparison(path, compare_robustness(result.groups, reference.groups))
+        << write_robustness_comparison(path, compare_robustness(result.groups, reference.groups),
+                                       paired_margins(result.rows, reference.rows, request.seed))
         << "wrote " << path << "\n";
   }
   return result;

@@ -178,15 +178,56 @@ std::vector<GroupComparison> compare_robustness(const std::vector<GroupMetrics>&
                                                 const std::vector<GroupMetrics>& reference,
                                                 const RobustnessBar& bar = {});
 
+/// The mean of paired differences and its 95 % percentile-bootstrap interval; NaN where there
+/// is no pair.
+struct PairedDifference {
+  int pairs = 0;
+  double mean = std::numeric_limits<double>::quiet_NaN();
+  double low = std::numeric_limits<double>::quiet_NaN();   ///< 2.5th percentile
+  double high = std::numeric_limits<double>::quiet_NaN();  ///< 97.5th percentile
+};
+
+/// The mean of `differences` and its 95 % interval from `resamples` bootstrap resamples (drawn
+/// with replacement from `seed`'s stream: the same inputs give the same interval). Throws
+/// std::invalid_argument for fewer than 100 resamples or a non-finite difference.
+PairedDifference bootstrap_mean(const std::vector<double>& differences, std::uint64_t seed,
+                                int resamples = 2000);
+
+/// One group: how far the policy lies from each threshold of the bar that compares means,
+/// episode by episode of the same draw. Negative is on the bar's side.
+struct GroupMargins {
+  std::string group;
+  int held_policy_only = 0;     ///< episodes the policy held and the PID did not
+  int held_reference_only = 0;  ///< episodes the PID held and the policy did not
+  PairedDifference time_s;      ///< policy - PID, episodes both reached
+  PairedDifference energy;      ///< policy - PID
+  PairedDifference hold_m;      ///< policy - PID - hold margin, episodes both reached
+  PairedDifference smoothness;  ///< policy - ratio x PID
+};
+
+/// The margins of every group, in the order the groups first appear in `policy`; rows are
+/// paired by group and episode number (the same suite, seed and episode count). Throws
+/// std::invalid_argument naming the group and episode of a policy row with no reference row.
+std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
+                                         const std::vector<SummaryRow>& reference,
+                                         std::uint64_t seed, const RobustnessBar& bar = {});
+
+/// A Markdown table of the margins: per group, the episodes only one controller held, then per
+/// criterion the mean and its 95 % interval.
+std::string robustness_margins_markdown(const std::vector<GroupMargins>& margins,
+                                        const RobustnessBar& bar = {});
+
 /// A Markdown table: one row per group, each criterion's two figures and pass/FAIL, then a
 /// line counting the groups that pass every criterion.
 std::string robustness_comparison_markdown(const std::vector<GroupComparison>& comparisons,
                                            const RobustnessBar& bar = {});
 
-/// Writes the Markdown table (robustness_comparison_markdown, the default bar) to path and
-/// returns it; throws std::runtime_error naming the path when it cannot.
+/// Writes the Markdown table (robustness_comparison_markdown, the default bar), then the
+/// margins' table when there are margins, to path and returns what it wrote; throws
+/// std::runtime_error naming the path when it cannot.
 std::string write_robustness_comparison(const std::string& path,
-                                        const std::vector<GroupComparison>& comparisons);
+                                        const std::vector<GroupComparison>& comparisons,
+                                        const std::vector<GroupMargins>& margins = {});
 
 /// What run_robustness did.
 struct RobustnessResult {

@@ -345,6 +345,93 @@ TEST(RobustnessComparison, EachCriterionOfTheBar) {
   EXPECT_NE(table.find("2 of 3 groups pass every criterion"), std::string::npos) << table;
 }
 
+TEST(RobustnessMargins, BootstrapIntervalOfTheMean) {
+  const PairedDifference same = bootstrap_mean(std::vector<double>(20, 0.5), 7);
+  EXPECT_EQ(same.pairs, 20);
+  EXPECT_DOUBLE_EQ(same.mean, 0.5);
+  EXPECT_DOUBLE_EQ(same.low, 0.5);
+  EXPECT_DOUBLE_EQ(same.high, 0.5);
+
+  const PairedDifference none = bootstrap_mean({}, 7);
+  EXPECT_EQ(none.pairs, 0);
+  EXPECT_TRUE(std::isnan(none.mean) && std::isnan(none.low) && std::isnan(none.high));
+
+  // 1..20: mean 10.5, standard error 5.92 / sqrt(20) = 1.32, so the 95 % interval is about
+  // 10.5 +- 2.6 (the bootstrap's is a little narrower: it divides by n, not n - 1).
+  std::vector<double> ramp;
+  for (int i = 1; i <= 20; ++i) ramp.push_back(i);
+  const PairedDifference r = bootstrap_mean(ramp, 7);
+  EXPECT_DOUBLE_EQ(r.mean, 10.5);
+  EXPECT_GT(r.low, 7.5);
+  EXPECT_LT(r.low, 8.6);
+  EXPECT_GT(r.high, 12.4);
+  EXPECT_LT(r.high, 13.5);
+  // Reproducible from the seed; another seed, other resamples.
+  const PairedDifference again = bootstrap_mean(ramp, 7);
+  EXPECT_EQ(again.low, r.low);
+  EXPECT_EQ(again.high, r.high);
+  const PairedDifference other = bootstrap_mean(ramp, 8);
+  EXPECT_TRUE(other.low != r.low || other.high != r.high);
+
+  EXPECT_THROW(bootstrap_mean(ramp, 7, 99), std::invalid_argument);
+  EXPECT_THROW(bootstrap_mean({1.0, std::nan("")}, 7), std::invalid_argument);
+}
+
+SummaryRow row(const std::string& group, int episode, double time_s, double hold_m, double energy,
+               double smoothness) {
+  SummaryRow r;
+  r.scenario = group;
+  r.episode = episode;
+  r.reached = time_s >= 0;
+  r.time_to_reach_s = time_s;
+  r.mean_error_after_reach_m = r.reached ? hold_m : -1.0;
+  r.final_error_m = r.reached ? hold_m : 5.0;
+  r.end_reason = r.reached ? task::EndReason::kReached : task::EndReason::kTimeLimit;
+  r.thrust_energy = energy;
+  r.smoothness = smoothness;
+  return r;
+}
+
+TEST(RobustnessMargins, PairsEpisodesAgainstTheBarsThresholds) {
+  // Group a: both reach twice. Group b: the policy never reaches, the PID holds.
+  const std::vector<SummaryRow> policy = {
+      row("a", 0, 9, 0.1, 30, 0.02), row("a", 1, 10, 0.2, 40, 0.02), row("b", 0, -1, 0, 70, 0.01)};
+  const std::vector<SummaryRow> pid = {row("b", 0, 12, 0.05, 60, 0.01),
+                                       row("a", 1, 10, 0.05, 50, 0.02),
+                                       row("a", 0, 10, 0.05, 50, 0.01)};
+  const std::vector<GroupMargins> m = paired_margins(policy, pid, 3);
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_EQ(m[0].group, "a");
+  EXPECT_EQ(m[0].time_s.pairs, 2);
+  EXPECT_DOUBLE_EQ(m[0].time_s.mean, -0.5);         // (9 - 10 + 10 - 10) / 2
+  EXPECT_DOUBLE_EQ(m[0].energy.mean, -15.0);        // (30 - 50 + 40 - 50) / 2
+  EXPECT_NEAR(m[0].hold_m.mean, 0.05, 1e-12);       // (0.1 - 0.1 + 0.2 - 0.1) / 2
+  EXPECT_NEAR(m[0].smoothness.mean, -0.01, 1e-12);  // (0.02 - 0.02 + 0.02 - 0.04) / 2
+  EXPECT_LE(m[0].time_s.low, -0.5);
+  EXPECT_GE(m[0].time_s.high, -0.5);
+  EXPECT_EQ(m[0].held_policy_only, 0);
+  EXPECT_EQ(m[0].held_reference_only, 0);
+  EXPECT_EQ(m[1].group, "b");
+  EXPECT_EQ(m[1].time_s.pairs, 0);
+  EXPECT_EQ(m[1].hold_m.pairs, 0);
+  EXPECT_EQ(m[1].energy.pairs, 1);
+  EXPECT_DOUBLE_EQ(m[1].energy.mean, 10.0);
+  EXPECT_EQ(m[1].held_policy_only, 0);
+  EXPECT_EQ(m[1].held_reference_only, 1);
+
+  const std::string table = robustness_margins_markdown(m);
+  EXPECT_NE(table.find("| a | 0 / 0 | -0.50 ["), std::string::npos) << table;
+  EXPECT_NE(table.find("| b | 0 / 1 | - | **+10.0 [+10.0, +10.0]** | - |"), std::string::npos)
+      << table;
+
+  try {
+    paired_margins({row("c", 4, 9, 0.1, 30, 0.02)}, pid, 3);
+    FAIL() << "a policy row without its PID row was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("group c episode 4"), std::string::npos) << e.what();
+  }
+}
+
 // The policy's integral action (task.integral) drives out what a steady push leaves: the
 // committed policy against 2 kg of extra buoyancy holds closer with it than without it.
 TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
@@ -439,6 +526,9 @@ TEST(RobustnessCommand, ComparesAPolicyWithThePid) {
     EXPECT_TRUE(std::filesystem::exists(dir.path(file))) << file;
   }
   EXPECT_NE(out.str().find("groups pass every criterion"), std::string::npos) << out.str();
+  // Then how sure each criterion is, episode by episode.
+  EXPECT_NE(out.str().find("| rest_start | "), out.str().rfind("| rest_start | ")) << out.str();
+  EXPECT_NE(out.str().find("How sure each criterion is"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("robustness suite (pid): 25 episodes"), std::string::npos);
   // --with-pid needs a policy; at least one episode per group.
   request.controller = "pid";

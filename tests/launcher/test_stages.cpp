@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -88,6 +89,13 @@ TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
                            "eval/pid/robustness_episodes.csv", "eval/robustness_comparison.md"}) {
     EXPECT_TRUE(fs::exists(tmp / "run" / file)) << file;
   }
+  // The comparison, then the margins with their intervals.
+  std::ifstream comparison(tmp / "run" / "eval/robustness_comparison.md");
+  const std::string text((std::istreambuf_iterator<char>(comparison)),
+                         std::istreambuf_iterator<char>());
+  EXPECT_LT(text.find("groups pass every criterion"), text.find("How sure each criterion is"))
+      << text;
+  EXPECT_NE(text.find("How sure each criterion is"), std::string::npos) << text;
   EXPECT_NE(out.str().find("robustness suite: 500 episodes each"), std::string::npos) << out.str();
 }
 
