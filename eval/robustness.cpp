@@ -419,7 +419,8 @@ PairedDifference bootstrap_mean(const std::vector<double>& differences, std::uin
 
 std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
                                          const std::vector<SummaryRow>& reference,
-                                         std::uint64_t seed, const RobustnessBar& bar) {
+                                         std::uint64_t seed, double reach_radius_m,
+                                         const RobustnessBar& bar) {
   std::map<std::pair<std::string, int>, const SummaryRow*> by_episode;
   for (const SummaryRow& r : reference) by_episode[{r.scenario, r.episode}] = &r;
   struct Differences {
@@ -438,8 +439,10 @@ std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
     const SummaryRow& r = *found->second;
     if (groups.find(p.scenario) == groups.end()) order.push_back(p.scenario);
     Differences& d = groups[p.scenario];
-    d.held_policy_only += is_held(p) && !is_held(r) ? 1 : 0;
-    d.held_reference_only += is_held(r) && !is_held(p) ? 1 : 0;
+    const bool policy_held = is_held(p, reach_radius_m);
+    const bool reference_held = is_held(r, reach_radius_m);
+    d.held_policy_only += policy_held && !reference_held ? 1 : 0;
+    d.held_reference_only += reference_held && !policy_held ? 1 : 0;
     if (p.reached && r.reached) {
       d.time_s.push_back(p.time_to_reach_s - r.time_to_reach_s);
       d.hold_m.push_back(p.mean_error_after_reach_m - r.mean_error_after_reach_m -
@@ -716,8 +719,9 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
     const std::string path =
         (std::filesystem::path(request.out_dir) / "robustness_comparison.md").string();
     out << "\n"
-        << write_robustness_comparison(path, compare_robustness(result.groups, reference.groups),
-                                       paired_margins(result.rows, reference.rows, request.seed))
+        << write_robustness_comparison(
+               path, compare_robustness(result.groups, reference.groups),
+               paired_margins(result.rows, reference.rows, request.seed, config.reach_radius_m))
         << "wrote " << path << "\n";
   }
   return result;

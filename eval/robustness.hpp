@@ -206,11 +206,13 @@ struct GroupMargins {
 };
 
 /// The margins of every group, in the order the groups first appear in `policy`; rows are
-/// paired by group and episode number (the same suite, seed and episode count). Throws
-/// std::invalid_argument naming the group and episode of a policy row with no reference row.
+/// paired by group and episode number (the same suite, seed and episode count); held as
+/// is_held says at reach_radius_m. Throws std::invalid_argument naming the group and episode of
+/// a policy row with no reference row.
 std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
                                          const std::vector<SummaryRow>& reference,
-                                         std::uint64_t seed, const RobustnessBar& bar = {});
+                                         std::uint64_t seed, double reach_radius_m = 0.5,
+                                         const RobustnessBar& bar = {});
 
 /// A Markdown table of the margins: per group, the episodes only one controller held, then per
 /// criterion the mean and its 95 % interval.
