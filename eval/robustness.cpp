@@ -437,8 +437,9 @@ std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
                                   std::to_string(p.episode) + " has no reference row");
     }
     const SummaryRow& r = *found->second;
-    if (groups.find(p.scenario) == groups.end()) order.push_back(p.scenario);
-    Differences& d = groups[p.scenario];
+    const auto [slot, first] = groups.try_emplace(p.scenario);
+    if (first) order.push_back(p.scenario);
+    Differences& d = slot->second;
     const bool policy_held = is_held(p, reach_radius_m);
     const bool reference_held = is_held(r, reach_radius_m);
     d.held_policy_only += policy_held && !reference_held ? 1 : 0;
@@ -453,7 +454,7 @@ std::vector<GroupMargins> paired_margins(const std::vector<SummaryRow>& policy,
   }
   std::vector<GroupMargins> out;
   for (const std::string& name : order) {
-    const Differences& d = groups[name];
+    const Differences& d = groups.at(name);
     // Each criterion its own stream, so that one criterion's pairs move no other's interval.
     out.push_back({name, d.held_policy_only, d.held_reference_only, bootstrap_mean(d.time_s, seed),
                    bootstrap_mean(d.energy, seed + 1), bootstrap_mean(d.hold_m, seed + 2),
