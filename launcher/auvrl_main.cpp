@@ -326,6 +326,9 @@ int run_finetune_command(int argc, const char* const* argv) {
              "the policy to fine-tune (default: the one the run's evaluation used)");
   cli.option("iterations", &options.iterations, "fine-tuning iterations (default: the config's)");
   cli.option("seed", &options.seed, "seed of the fine-tuning's way-points (default: the run's)");
+  cli.flag("keep-iterates", &options.keep_iterates,
+           "also write the weights validated every 10 iterations (and the last) to\n"
+           "OUT/iterates/iteration_NNN.nn, to evaluate the fine-tuning's course");
   if (!cli.parse(argc, argv)) return 0;
   return auvrl::launcher::refinetune(options, std::cout);
 }

@@ -79,6 +79,12 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
       return;
     }
+    if (in.keep_iterates) {
+      const fs::path iterates = fs::path(in.run_dir) / "iterates";
+      fs::create_directories(iterates);
+      nn::save_network_file((iterates / fmt::format("iteration_{:03d}.nn", it.iteration)).string(),
+                            weights);
+    }
     const eval::ValidationScore score = in.validation.evaluate(weights);
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
     if (eval::ranks_above(score, best.score, ranking)) best = {score, weights, it.iteration};
@@ -112,14 +118,14 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 }
 
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
-                                   std::ostream& out) {
+                                   std::ostream& out, bool keep_iterates) {
   if (ctx.rc.finetune.iterations <= 0) return policy_path;
   // The quick evaluation's way-points, and half as many again facing a random heading.
   const eval::QuickEvaluator validation(ctx.model, ctx.rc.task, ctx.rc.run.best_eval_suite,
                                         ctx.rc.run.best_eval_suite / 2);
   try {
     return finetune_stage({ctx.model, ctx.rc.task, ctx.rc.finetune, ctx.rc.run.seed, validation,
-                           ctx.rc.run.best_eval_max_hold_m, ctx.run_dir},
+                           ctx.rc.run.best_eval_max_hold_m, ctx.run_dir, keep_iterates},
                           policy_path, out);
   } catch (const std::exception& e) {
     // The trained policy stays: a failed fine-tuning (a full disk, say) loses nothing.

@@ -29,6 +29,10 @@ struct FinetuneStageInput {
   const eval::QuickEvaluator& validation;  ///< scores candidate weights
   double max_hold_m = 0.15;                ///< the ranking's hold limit, m
   std::string run_dir;
+  /// When true, the weights scored on the validation way-points are also written to
+  /// run_dir/iterates/iteration_NNN.nn (the iteration's number, three digits at least), for
+  /// evaluating how the fine-tuning went beyond what it keeps.
+  bool keep_iterates = false;
 };
 
 /// Fine-tunes the policy at start_path (progress to finetune.csv) and returns the path of the
@@ -40,10 +44,10 @@ struct FinetuneStageInput {
 std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
                            std::ostream& out);
 
-/// Runs the fine-tuning stage when configured; on a failure keeps policy_path. Returns the path
-/// of the policy to evaluate.
+/// Runs the fine-tuning stage when configured (keep_iterates: FinetuneStageInput's); on a failure
+/// keeps policy_path. Returns the path of the policy to evaluate.
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
-                                   std::ostream& out);
+                                   std::ostream& out, bool keep_iterates = false);
 
 /// The evaluation of a policy and of the PID baseline on every scenario and on the robustness
 /// suite.

@@ -52,7 +52,7 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
     fs::copy_file(o.config_path, fs::path(o.out_dir) / "finetune_config.yaml");
   }
   out << "auvrl finetune: " << policy << " (run " << o.run_dir << ") into " << o.out_dir << "\n";
-  const std::string kept = finetune_if_configured(ctx, policy, out);
+  const std::string kept = finetune_if_configured(ctx, policy, out, o.keep_iterates);
   sign_policies(o.out_dir, ensure_run_key(o.run_dir), out);  // the trained run's key
   const EvaluationResult evaluation = evaluate_stage(ctx, kept, out);
   report_stage(ctx, kept, evaluation, out);

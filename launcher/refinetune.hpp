@@ -20,6 +20,8 @@ struct RefinetuneOptions {
   int iterations = -1;      ///< overrides finetune.iterations when >= 0
   std::int64_t seed = -1;   ///< overrides run.seed (the fine-tuning's way-points) when >= 0
   std::string source_dir;   ///< the source tree (scripts/ for the plots)
+  /// Also write every validated iterate to out_dir/iterates/ (FinetuneStageInput::keep_iterates).
+  bool keep_iterates = false;
 };
 
 /// Fine-tunes and evaluates as `auvrl train`'s stages do; the output directory gets the run's

@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "child_process.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/serialize.hpp"
 #include "launcher/launcher.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/refinetune.hpp"
@@ -112,8 +114,18 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   o.run_dir = options.run_dir;
   o.out_dir = (tmp / "again").string();
   o.iterations = 2;
+  o.keep_iterates = true;
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  // The last iteration is validated, so kept: the committed policy's shape, other weights.
+  const fs::path iterate = tmp / "again" / "iterates" / "iteration_002.nn";
+  ASSERT_TRUE(fs::exists(iterate));
+  EXPECT_FALSE(fs::exists(tmp / "again" / "iterates" / "iteration_001.nn"));
+  const nn::Mlp start =
+      nn::network_from_bytes(nn::read_file((tmp / "run" / "policy.nn").string()), 1);
+  const nn::Mlp second = nn::network_from_bytes(nn::read_file(iterate.string()), 1);
+  EXPECT_EQ(second.params().size(), start.params().size());
+  EXPECT_NE(second.params(), start.params());
   EXPECT_NE(out.str().find("fine-tuning " + options.run_dir + "/policy.nn"), std::string::npos)
       << out.str();
   for (const char* file : {"config.yaml", "finetune.csv", "eval/selected_policy.txt",
