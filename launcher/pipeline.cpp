@@ -74,14 +74,15 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   const eval::Ranking ranking = finetune_ranking(in.config, in.max_hold_m);
   FinetuneBest best{before, std::nullopt, 0};
   FinetuneSink csv((fs::path(in.run_dir) / "finetune.csv").string());
+  // Made once, before the search: a folder that cannot be made fails before its work.
+  const fs::path iterates = fs::path(in.run_dir) / "iterates";
+  if (in.keep_iterates) fs::create_directories(iterates);
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
     if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations) {
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
       return;
     }
     if (in.keep_iterates) {
-      const fs::path iterates = fs::path(in.run_dir) / "iterates";
-      fs::create_directories(iterates);
       nn::save_network_file((iterates / fmt::format("iteration_{:03d}.nn", it.iteration)).string(),
                             weights);
     }
