@@ -61,6 +61,8 @@ void add_objective_fields(config::Table<tuning::FinetuneConfig>& t) {
           "|roll| or |pitch| beyond this costs flip_margin_weight");
   t.field("flip_margin_weight", &C::flip_margin_weight, "s per rad", "see flip_margin_rad");
   t.field("episode_steps", &C::episode_steps, "steps", "each episode's length");
+  t.field("randomised_episode_steps", &C::randomised_episode_steps, "steps, 0: episode_steps",
+          "the randomised way-points' episode length");
   t.field("pid_lag_weight", &C::pid_lag_weight, "s per s",
           "cost of arriving later than pid_lead_s before the PID baseline");
   t.field("pid_lead_s", &C::pid_lead_s, "s", "see pid_lag_weight");
@@ -90,6 +92,8 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "of them, under the conditions finetune.randomise draws (faults, currents, noise, "
           "model)");
   t.section("randomise", task::randomise_table(), &C::randomise);
+  t.field("noisy_fraction", &C::noisy_fraction, "0..1",
+          "of the others, with sensor noise only (finetune.randomise's levels and scale)");
   add_objective_fields(t);
   t.field("threads", &C::threads, "0: one per CPU", "policies evaluated at once");
   return t;

@@ -70,6 +70,7 @@ void FinetuneConfig::validate() const {
   require(std::isfinite(flip_margin_weight) && flip_margin_weight >= 0,
           "flip_margin_weight must be >= 0");
   require(episode_steps >= 1, "episode_steps must be >= 1");
+  require(randomised_episode_steps >= 0, "randomised_episode_steps must be >= 0");
   require(std::isfinite(pid_lag_weight) && pid_lag_weight >= 0, "pid_lag_weight must be >= 0");
   require(std::isfinite(pid_lead_s), "pid_lead_s must be finite");
   require(std::isfinite(energy_weight) && energy_weight >= 0, "energy_weight must be >= 0");
@@ -79,6 +80,7 @@ void FinetuneConfig::validate() const {
   require(threads >= 0, "threads must be >= 0");
   require(randomised_fraction >= 0 && randomised_fraction <= 1,
           "randomised_fraction must be in [0, 1]");
+  require(noisy_fraction >= 0 && noisy_fraction <= 1, "noisy_fraction must be in [0, 1]");
   std::string key;
   const std::string what = randomise.check(key);
   require(what.empty(), "randomise." + key + " " + what);
@@ -98,6 +100,18 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   std::mt19937_64 starts_rng = finetune_stream(seed, 0x57A7u);
   const int any_start = static_cast<int>(std::lround(config.any_start_fraction * config.episodes));
   const int facing_away = static_cast<int>(std::lround(config.facing_away_fraction * turned));
+  // Sensor noise alone, on a share of the others.
+  std::mt19937_64 noise_rng = finetune_stream(seed, 0x2015Eu);
+  task::EpisodeRandomisation noise_only;
+  noise_only.sensor_noise_probability = 1.0;
+  noise_only.sensor_noise_scale = config.randomise.sensor_noise_scale;
+  noise_only.sensor_noise_position_m = config.randomise.sensor_noise_position_m;
+  noise_only.sensor_noise_attitude_rad = config.randomise.sensor_noise_attitude_rad;
+  noise_only.sensor_noise_velocity_mps = config.randomise.sensor_noise_velocity_mps;
+  noise_only.sensor_noise_angular_rate_rad_s = config.randomise.sensor_noise_angular_rate_rad_s;
+  const int plain = config.episodes - randomised;
+  const int noisy = static_cast<int>(std::lround(config.noisy_fraction * plain));
+  int plain_so_far = 0;
   // Whether item i of n is one of the k spread evenly through them.
   const auto spread = [](int k, int i, int n) { return k > 0 && (i * k) / n != ((i + 1) * k) / n; };
   int faults = 0;
@@ -127,6 +141,10 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
     if (spread(randomised, i, config.episodes)) {
       if (conditions.fault_thruster >= 0) ++faults;
       agent::apply_conditions(conditions, e.start);
+      e.max_steps = config.randomised_episode_steps;
+    } else if (spread(noisy, plain_so_far++, plain)) {
+      agent::apply_conditions(task::sample_conditions(noise_only, task.num_thrusters, noise_rng),
+                              e.start);
     }
     e.start.seed = seed * 1000 + static_cast<std::uint64_t>(i);
     episodes.push_back(e);
@@ -163,6 +181,35 @@ double thrust_price_s(const agent::EpisodeSummary& summary,
          config.smoothness_weight * eval::trajectory_smoothness(trajectory, 0, max_thrust_n);
 }
 
+/// The search's direction from one iteration's objectives (value[s]: pair s / 2, sign + for
+/// even s) and the pairs' perturbations: rank shaping gives the lowest objective +0.5 and the
+/// highest -0.5 (robust to the scale and to the outliers of a way-point not reached), and the
+/// antithetic pairs' utility differences weight their perturbations. It points to a lower
+/// objective.
+Eigen::VectorXf rank_weighted_direction(const std::vector<double>& value,
+                                        const std::vector<Eigen::VectorXf>& noise, double sigma) {
+  const int samples = static_cast<int>(value.size());
+  const int pairs = static_cast<int>(noise.size());
+  std::vector<int> order(static_cast<std::size_t>(samples));
+  for (int s = 0; s < samples; ++s) order[static_cast<std::size_t>(s)] = s;
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return value[static_cast<std::size_t>(a)] < value[static_cast<std::size_t>(b)];
+  });
+  std::vector<double> utility(static_cast<std::size_t>(samples));
+  for (int r = 0; r < samples; ++r) {
+    utility[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] =
+        0.5 - static_cast<double>(r) / static_cast<double>(samples - 1);
+  }
+  Eigen::VectorXf direction = Eigen::VectorXf::Zero(noise.front().size());
+  for (int k = 0; k < pairs; ++k) {
+    direction += static_cast<float>(utility[static_cast<std::size_t>(2 * k)] -
+                                    utility[static_cast<std::size_t>(2 * k + 1)]) *
+                 noise[static_cast<std::size_t>(k)];
+  }
+  direction /= static_cast<float>(pairs * sigma);
+  return direction;
+}
+
 }  // namespace
 
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
@@ -172,7 +219,8 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
   task::apply_vehicle(plant.facts(), t);
-  t.max_steps = config.episode_steps;
+  const int episode_steps = episode.max_steps > 0 ? episode.max_steps : config.episode_steps;
+  t.max_steps = episode_steps;
   if (episode.safety_radius_m > 0.0) t.beta_max_m = episode.safety_radius_m;
   // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
   agent::EpisodeOptions options;
@@ -228,7 +276,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
     return arrival_s + config.hold_weight * sum_m / n +
            config.hold_turn_weight * std::abs(turn_rad) / (n * dt) + margin_s + lag_s(arrival_s);
   }
-  const double give_up_s = config.episode_steps * dt;
+  const double give_up_s = episode_steps * dt;
   return give_up_s + closest_m + margin_s + lag_s(give_up_s);
 }
 
@@ -306,25 +354,7 @@ FinetuneResult finetune_policy(
     work(0);
     for (std::thread& t : pool) t.join();
 
-    // Rank shaping: the lowest objective gets +0.5, the highest -0.5 (robust to the scale
-    // and to the outliers of a way-point not reached).
-    std::vector<int> order(static_cast<std::size_t>(samples));
-    for (int s = 0; s < samples; ++s) order[static_cast<std::size_t>(s)] = s;
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      return value[static_cast<std::size_t>(a)] < value[static_cast<std::size_t>(b)];
-    });
-    std::vector<double> utility(static_cast<std::size_t>(samples));
-    for (int r = 0; r < samples; ++r) {
-      utility[static_cast<std::size_t>(order[static_cast<std::size_t>(r)])] =
-          0.5 - static_cast<double>(r) / static_cast<double>(samples - 1);
-    }
-    Eigen::VectorXf direction = Eigen::VectorXf::Zero(p);
-    for (int k = 0; k < config.pairs; ++k) {
-      direction += static_cast<float>(utility[static_cast<std::size_t>(2 * k)] -
-                                      utility[static_cast<std::size_t>(2 * k + 1)]) *
-                   noise[static_cast<std::size_t>(k)];
-    }
-    direction /= static_cast<float>(config.pairs * config.sigma);
+    Eigen::VectorXf direction = rank_weighted_direction(value, noise, config.sigma);
     // The direction lowers the objective; Adam descends, so it steps on the negative.
     direction = -direction;
     adam.step(theta, direction);

@@ -15,7 +15,8 @@
 // The objective's way-points are drawn from the task's goal region with a stream of their own
 // (never the evaluation's suite nor the launcher's validation way-points), from the task's
 // fixed start, a fraction of them facing a random heading (as test2 does), a fraction under the
-// conditions the fine-tuning's own randomisation (finetune.randomise) draws.
+// conditions the fine-tuning's own randomisation (finetune.randomise) draws, and a fraction of
+// the others with sensor noise only.
 #pragma once
 
 #include <Eigen/Core>
@@ -59,6 +60,11 @@ struct FinetuneConfig {
   /// water, where it learns fastest, and the fine-tuning still see the conditions a vehicle
   /// meets.
   task::EpisodeRandomisation randomise;
+  /// Of the way-points without randomised conditions, this share (spread through them) gets
+  /// sensor noise only: randomise's sensor_noise_* levels times a factor drawn from its
+  /// sensor_noise_scale, from a stream of its own. Noise on the faulted way-points as well
+  /// would make them harder than the faults the fine-tuning is there to learn.
+  double noisy_fraction = 0.0;
   /// Objective of one way-point, s: the time to within the reach radius (interpolated
   /// between control steps, so that braking a little later counts before it gains a whole
   /// step) plus hold_weight times the mean distance over the arrival step and the hold_steps
@@ -81,6 +87,10 @@ struct FinetuneConfig {
   /// Each episode's length; a way-point not reached costs this time plus the closest
   /// approach (at 1 s per m).
   int episode_steps = 250;
+  /// The randomised way-points' episode length (0: episode_steps). A thruster fault slows the
+  /// arrival, and with the common length the hold a fault upsets most (the depth's slow swing
+  /// with a vertical thruster dead) is priced only for its first seconds.
+  int randomised_episode_steps = 0;
   /// Integrator steps per control step in the objective's episodes (0: the vehicle file's).
   /// They only rank perturbed weights; the validation and the evaluation run the vehicle's
   /// own; a coarser integrator ranks them the same at a fraction of the cost.
@@ -115,6 +125,8 @@ struct FinetuneEpisode {
   double pid_arrival_s = std::numeric_limits<double>::quiet_NaN();
   /// The episode's safety sphere around the way-point, m (0: the task's beta_max_m).
   double safety_radius_m = 0.0;
+  /// The episode's length, steps (0: FinetuneConfig::episode_steps).
+  int max_steps = 0;
 };
 
 /// The objective's way-points for a run seed (see the file comment).

@@ -183,6 +183,62 @@ TEST(FinetuneEpisodes, FaultsTakeTheThrustersInTurn) {
   }
 }
 
+// randomised_episode_steps: the randomised way-points run that long, the others the common
+// length (max_steps 0).
+TEST(FinetuneEpisodes, TheRandomisedOnesRunTheirOwnLength) {
+  FinetuneConfig c;
+  c.episodes = 12;
+  c.randomised_fraction = 0.25;
+  c.randomise.fault_probability = 1.0;
+  c.randomised_episode_steps = 400;
+  int long_ones = 0;
+  for (const FinetuneEpisode& e : finetune_episodes(fast_task(), c, 5)) {
+    EXPECT_EQ(e.max_steps, e.start.thruster_efficiency.empty() ? 0 : 400);
+    long_ones += e.max_steps == 400;
+  }
+  EXPECT_EQ(long_ones, 3);
+  c.randomised_episode_steps = -1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
+// noisy_fraction: that share of the way-points without randomised conditions gets sensor noise
+// at finetune.randomise's levels (scaled by a drawn factor) and nothing else; the way-points,
+// headings and faults stay as they were.
+TEST(FinetuneEpisodes, NoiseTheShareAskedOfThePlainOnes) {
+  FinetuneConfig c;
+  c.episodes = 20;
+  c.random_heading_fraction = 0.5;
+  c.randomised_fraction = 0.4;
+  c.randomise.fault_probability = 1.0;
+  c.randomise.sensor_noise_scale = {0.5, 1.5};
+  const auto quiet = finetune_episodes(fast_task(), c, 9);
+  c.noisy_fraction = 0.25;
+  const auto noisy = finetune_episodes(fast_task(), c, 9);
+  ASSERT_EQ(noisy.size(), quiet.size());
+  int noised = 0;
+  for (std::size_t i = 0; i < noisy.size(); ++i) {
+    EXPECT_EQ(noisy[i].goal_ned_m, quiet[i].goal_ned_m);
+    EXPECT_EQ(noisy[i].start.euler_rpy_rad, quiet[i].start.euler_rpy_rad);
+    EXPECT_EQ(noisy[i].start.thruster_efficiency, quiet[i].start.thruster_efficiency);
+    EXPECT_EQ(quiet[i].start.sensor_noise.position_sigma_m, 0.0);
+    const sim::SensorNoise& n = noisy[i].start.sensor_noise;
+    if (n.position_sigma_m == 0.0) continue;
+    ++noised;
+    EXPECT_TRUE(noisy[i].start.thruster_efficiency.empty()) << "noise only on the plain ones";
+    EXPECT_TRUE(noisy[i].start.current_ned_mps.isZero());
+    EXPECT_TRUE(noisy[i].start.model_variation.is_identity());
+    const double factor = n.position_sigma_m / 0.1;
+    EXPECT_GE(factor, 0.5);
+    EXPECT_LE(factor, 1.5);
+    EXPECT_NEAR(n.attitude_sigma_rad, 0.02 * factor, 1e-12);
+    EXPECT_NEAR(n.linear_velocity_sigma_mps, 0.05 * factor, 1e-12);
+    EXPECT_NEAR(n.angular_velocity_sigma_rad_s, 0.02 * factor, 1e-12);
+  }
+  EXPECT_EQ(noised, 3) << "a quarter of the 12 plain way-points";
+  c.noisy_fraction = -0.1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
 TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   const task::TaskConfig t = fast_task();
   FinetuneEpisode e;
@@ -345,6 +401,16 @@ TEST(ArrivalObjective, NotArrivingCostsTheEpisodeTimePlusTheClosestApproach) {
   IdleController idle;
   const double j = arrival_objective(nessie(), fast_task(), idle, e, c);
   EXPECT_NEAR(j, 5.0 + 5.0, 0.05) << "the vehicle barely drifts (1 N buoyant)";
+}
+
+TEST(ArrivalObjective, AnEpisodesOwnLengthReplacesTheCommonOne) {
+  FinetuneEpisode e;
+  e.goal_ned_m = Eigen::Vector3d(3.0, 4.0, 5.0);
+  FinetuneConfig c;
+  c.episode_steps = 50;
+  e.max_steps = 100;
+  IdleController idle;
+  EXPECT_NEAR(arrival_objective(nessie(), fast_task(), idle, e, c), 10.0 + 5.0, 0.05);
 }
 
 // A way-point farther than the task's safety sphere (20 m) from its start: the episode's own
