@@ -45,6 +45,18 @@ std::mt19937_64 finetune_stream(std::uint64_t seed, std::uint32_t tag) {
                     0xF17E7u, tag};
   return std::mt19937_64(seq);
 }
+
+/// The randomisation with every kind but its sensor noise off, and that always on (its levels
+/// and scale as they are).
+task::EpisodeRandomisation sensor_noise_only(task::EpisodeRandomisation randomisation) {
+  randomisation.fault_probability = 0.0;
+  randomisation.current_probability = 0.0;
+  randomisation.varying_current_probability = 0.0;
+  randomisation.model_probability = 0.0;
+  randomisation.sensor_noise_probability = 1.0;
+  return randomisation;
+}
+
 }  // namespace
 
 void FinetuneConfig::validate() const {
@@ -102,13 +114,7 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   const int facing_away = static_cast<int>(std::lround(config.facing_away_fraction * turned));
   // Sensor noise alone, on a share of the others.
   std::mt19937_64 noise_rng = finetune_stream(seed, 0x2015Eu);
-  task::EpisodeRandomisation noise_only;
-  noise_only.sensor_noise_probability = 1.0;
-  noise_only.sensor_noise_scale = config.randomise.sensor_noise_scale;
-  noise_only.sensor_noise_position_m = config.randomise.sensor_noise_position_m;
-  noise_only.sensor_noise_attitude_rad = config.randomise.sensor_noise_attitude_rad;
-  noise_only.sensor_noise_velocity_mps = config.randomise.sensor_noise_velocity_mps;
-  noise_only.sensor_noise_angular_rate_rad_s = config.randomise.sensor_noise_angular_rate_rad_s;
+  const task::EpisodeRandomisation noise_only = sensor_noise_only(config.randomise);
   const int plain = config.episodes - randomised;
   const int noisy = static_cast<int>(std::lround(config.noisy_fraction * plain));
   int plain_so_far = 0;
