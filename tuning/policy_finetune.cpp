@@ -225,8 +225,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
   task::apply_vehicle(plant.facts(), t);
-  const int episode_steps = episode.max_steps > 0 ? episode.max_steps : config.episode_steps;
-  t.max_steps = episode_steps;
+  t.max_steps = episode.max_steps > 0 ? episode.max_steps : config.episode_steps;
   if (episode.safety_radius_m > 0.0) t.beta_max_m = episode.safety_radius_m;
   // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
   agent::EpisodeOptions options;
@@ -282,7 +281,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
     return arrival_s + config.hold_weight * sum_m / n +
            config.hold_turn_weight * std::abs(turn_rad) / (n * dt) + margin_s + lag_s(arrival_s);
   }
-  const double give_up_s = episode_steps * dt;
+  const double give_up_s = t.max_steps * dt;
   return give_up_s + closest_m + margin_s + lag_s(give_up_s);
 }
 

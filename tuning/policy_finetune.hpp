@@ -88,8 +88,8 @@ struct FinetuneConfig {
   /// approach (at 1 s per m).
   int episode_steps = 250;
   /// The randomised way-points' episode length (0: episode_steps). A thruster fault slows the
-  /// arrival, and with the common length the hold a fault upsets most (the depth's slow swing
-  /// with a vertical thruster dead) is priced only for its first seconds.
+  /// arrival, and an episode ends at its length even before hold_steps of hold have passed:
+  /// with the common length a late arrival's hold is priced for its first seconds only.
   int randomised_episode_steps = 0;
   /// Integrator steps per control step in the objective's episodes (0: the vehicle file's).
   /// They only rank perturbed weights; the validation and the evaluation run the vehicle's
