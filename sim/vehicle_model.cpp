@@ -33,6 +33,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -244,14 +245,21 @@ const config::Table<VehicleFile>& vehicle_file_table() {
   return table;
 }
 
-/// The file's YAML; a missing file or a syntax error is a VehicleFileError.
+/// The file's YAML; a missing or unreadable file (a directory opens as a stream and fails on
+/// its first read) or a syntax error is a VehicleFileError.
 YAML::Node load_yaml(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw VehicleFileError(path, "(file)", "is a directory, not a vehicle file");
+  }
   try {
     return YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw VehicleFileError(path, "(file)", "cannot open the file");
   } catch (const YAML::ParserException& e) {
     throw VehicleFileError(path, "(syntax)", e.what());
+  } catch (const std::ios_base::failure& e) {
+    throw VehicleFileError(path, "(file)", std::string("cannot read the file: ") + e.what());
   }
 }
 

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <ios>
 #include <limits>
 
 namespace auvrl::config {
@@ -248,6 +250,11 @@ void Section::finish() const {
 }
 
 Section load_file(const std::string& path) {
+  // A directory opens as a stream and fails on its first read (std::ios_base::failure).
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError(path + ": is a directory, not a YAML file");
+  }
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
@@ -255,6 +262,8 @@ Section load_file(const std::string& path) {
     throw ConfigError(path + ": cannot read the file");
   } catch (const YAML::Exception& e) {
     throw ConfigError(path + ": not valid YAML: " + e.what());
+  } catch (const std::ios_base::failure& e) {
+    throw ConfigError(path + ": cannot read the file: " + e.what());
   }
   return Section(path, "", root);
 }

@@ -320,3 +320,18 @@ TEST(ConfigTable, ListEntriesAreDocumentedButGetNoFlags) {
 }
 
 }  // namespace
+
+TEST(ConfigTable, FilesThatCannotBeReadAreErrorsNamingThem) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "auvrl_test_config_table_unreadable";
+  std::filesystem::create_directories(dir);
+  for (const std::string& path : {(dir / "absent.yaml").string(), dir.string()}) {
+    try {
+      config::load_file(path);
+      ADD_FAILURE() << path << " accepted";
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}

@@ -357,6 +357,14 @@ TEST(VehicleFileValidation, TooManyThrusters) {
 TEST(VehicleFileValidation, MissingFileAndSyntaxError) {
   TempDir dir;
   EXPECT_THROW(load_vehicle_file(dir.file("absent.yaml")), VehicleFileError);
+  // A directory (as `vehicle: .` in a run file names): an error naming it, not a stream failure.
+  try {
+    load_vehicle_file(dir.file("."));
+    FAIL() << "a directory accepted";
+  } catch (const VehicleFileError& e) {
+    EXPECT_EQ(e.field(), "(file)") << e.what();
+    EXPECT_NE(std::string(e.what()).find("directory"), std::string::npos) << e.what();
+  }
   write_text(dir.file("bad.yaml"), "name: [unclosed\n");
   try {
     load_vehicle_file(dir.file("bad.yaml"));
