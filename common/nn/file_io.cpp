@@ -5,6 +5,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -83,6 +84,11 @@ void write_file_atomically(const std::string& path, const std::vector<std::uint8
 }
 
 std::vector<std::uint8_t> read_file(const std::string& path) {
+  // A directory opens as a stream, with a size that is not a file's.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw std::runtime_error("'" + path + "' is a directory, not a file");
+  }
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw std::runtime_error("cannot open '" + path + "' for reading");
   const std::streamoff size = in.tellg();

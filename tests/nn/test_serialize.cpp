@@ -219,5 +219,13 @@ TEST(NetworkFile, AtomicWriteAndReadBack) {
   EXPECT_NE(message_of([&] { load_network_file(path, c); }).find("cannot open"), std::string::npos);
 }
 
+TEST(NetworkFile, ADirectoryIsAnErrorNamingIt) {
+  // A directory opens as a stream; its size is not a file's (it once asked for petabytes).
+  const std::string dir = ::testing::TempDir();
+  const std::string msg = message_of([&] { read_file(dir); });
+  EXPECT_NE(msg.find(dir), std::string::npos) << msg;
+  EXPECT_NE(msg.find("is a directory"), std::string::npos) << msg;
+}
+
 }  // namespace
 }  // namespace auvrl::nn
