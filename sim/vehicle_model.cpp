@@ -33,14 +33,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "common/config/table.hpp"
+#include "common/config/yaml_config.hpp"
 
 namespace auvrl::sim {
 namespace {
@@ -245,29 +243,17 @@ const config::Table<VehicleFile>& vehicle_file_table() {
   return table;
 }
 
-/// The file's YAML; a missing or unreadable file (a directory opens as a stream and fails on
-/// its first read) or a syntax error is a VehicleFileError.
-YAML::Node load_yaml(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw VehicleFileError(path, "(file)", "is a directory, not a vehicle file");
-  }
+/// The file's YAML from its text; a syntax error is a VehicleFileError.
+YAML::Node parse_yaml(const std::string& path, const std::string& text) {
   try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw VehicleFileError(path, "(file)", "cannot open the file");
+    return YAML::Load(text);
   } catch (const YAML::ParserException& e) {
     throw VehicleFileError(path, "(syntax)", e.what());
-  } catch (const std::ios_base::failure& e) {
-    throw VehicleFileError(path, "(file)", std::string("cannot read the file: ") + e.what());
   }
 }
 
 /// CRC-32 of the file's bytes (the vehicle's identity on the wire).
-std::uint32_t file_crc32(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in && !in.eof()) throw VehicleFileError(path, "(file)", "cannot read the file");
+std::uint32_t bytes_crc32(const std::string& bytes) {
   return static_cast<std::uint32_t>(
       crc32(0L, reinterpret_cast<const Bytef*>(bytes.data()), static_cast<uInt>(bytes.size())));
 }
@@ -534,9 +520,13 @@ const config::Table<BlowUpLimits>& blow_up_limits_table() {
 config::SectionDoc vehicle_file_doc() { return config::section_doc(vehicle_file_table()); }
 
 VehicleModel load_vehicle_file(const std::string& path) {
-  VehicleFile file = read_vehicle_file(path, load_yaml(path));
+  // Read once: the same bytes are parsed and give the file's CRC-32.
+  std::string text;
+  std::string why;
+  if (!config::read_text_file(path, text, why)) throw VehicleFileError(path, "(file)", why);
+  VehicleFile file = read_vehicle_file(path, parse_yaml(path, text));
   file.model.source_file = path;
-  file.model.file_crc32 = file_crc32(path);
+  file.model.file_crc32 = bytes_crc32(text);
   apply_hydrostatics(file);
   finalize_vehicle_model(file.model);
   return std::move(file.model);

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <ios>
+#include <iterator>
 #include <limits>
 
 namespace auvrl::config {
@@ -249,21 +251,39 @@ void Section::finish() const {
   }
 }
 
-Section load_file(const std::string& path) {
-  // A directory opens as a stream and fails on its first read (std::ios_base::failure).
+bool read_text_file(const std::string& path, std::string& text, std::string& why) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
-    throw ConfigError(path + ": is a directory, not a YAML file");
+    why = "is a directory, not a file";
+    return false;
   }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    why = "cannot open the file";
+    return false;
+  }
+  try {
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  } catch (const std::ios_base::failure& e) {
+    why = std::string("cannot read the file: ") + e.what();
+    return false;
+  }
+  if (in.bad()) {
+    why = "cannot read the file";
+    return false;
+  }
+  return true;
+}
+
+Section load_file(const std::string& path) {
+  std::string text;
+  std::string why;
+  if (!read_text_file(path, text, why)) throw ConfigError(path + ": " + why);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path + ": cannot read the file");
+    root = YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(path + ": not valid YAML: " + e.what());
-  } catch (const std::ios_base::failure& e) {
-    throw ConfigError(path + ": cannot read the file: " + e.what());
   }
   return Section(path, "", root);
 }

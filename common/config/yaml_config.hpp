@@ -91,8 +91,14 @@ class Section {
   std::set<std::string> read_;
 };
 
+/// Reads a whole file's bytes into `text`. Returns false with `why` set ("cannot open the file",
+/// "is a directory, not a file", "cannot read the file") when it cannot: a directory opens as a
+/// stream and fails only on its first read, with std::ios_base::failure. Every YAML file (run,
+/// mission, vehicle) is read through here.
+bool read_text_file(const std::string& path, std::string& text, std::string& why);
+
 /// Loads a YAML file whose top level is a map; throws ConfigError naming the file on a
-/// missing file or a syntax error.
+/// missing or unreadable file or a syntax error.
 Section load_file(const std::string& path);
 /// The same for YAML text that arrived otherwise (a message); `origin` names it in errors.
 Section load_text(const std::string& text, const std::string& origin);
