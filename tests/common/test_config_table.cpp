@@ -6,6 +6,7 @@
 
 #include "common/cli.hpp"
 #include "common/config/table.hpp"
+#include "common/config/yaml_config.hpp"
 
 namespace {
 
@@ -319,8 +320,6 @@ TEST(ConfigTable, ListEntriesAreDocumentedButGetNoFlags) {
   EXPECT_THROW(parse(cmd, {"--gains", "1,2"}), cli::UsageError);
 }
 
-}  // namespace
-
 TEST(ConfigTable, FilesThatCannotBeReadAreErrorsNamingThem) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / "auvrl_test_config_table_unreadable";
@@ -335,3 +334,5 @@ TEST(ConfigTable, FilesThatCannotBeReadAreErrorsNamingThem) {
   }
   std::filesystem::remove_all(dir);
 }
+
+}  // namespace
