@@ -8,16 +8,20 @@ scenarios), drawn from fixed seeds so that anyone gets the same files:
                     random.Random(4242); 30 by default);
   legs/l<k>.yaml    legs from anywhere: start and way-point drawn uniformly in the training
                     region (at least 3 m apart), the heading uniform (random.Random(777); 40 by
-                    default), as a mission's later legs start.
+                    default), as a mission's later legs start;
+  ahead/a<k>.yaml   way-points from the task's start at rest facing north, as test1 and the
+                    fine-tuning's plain way-points start: a way-point drawn uniformly in the
+                    training region at least 3 m away (random.Random(1357); 120 by default).
 
 Every file is config/missions/test2.yaml with its start, heading and way-point replaced (so the
 missions' limits are test2's: depth 0.5..20 m, |roll| <= 0.5 rad, |pitch| <= 0.8 rad), the
 vehicle named by its absolute path, and for the legs at most 40 m from the start (a start and a
 way-point in the region may be 31.5 m apart). Run each with
-`build/bin/auvrl eval --policy P --mission FILE --out DIR` (or `--controller pid`); the lab note
-docs/lab-notes/2026-11-25-facing-away.md measured policies on them.
+`build/bin/auvrl eval --policy P --mission FILE --out DIR` (or `--controller pid`), or a whole
+set with scripts/mission_lateness.py; the lab notes docs/lab-notes/2026-11-25-facing-away.md and
+docs/lab-notes/2026-11-26-mined-way-points.md measured policies on them.
 
-Usage: scripts/validation_missions.py OUT_DIR [--behind N] [--legs N]
+Usage: scripts/validation_missions.py OUT_DIR [--behind N] [--legs N] [--ahead N]
 """
 import argparse
 import math
@@ -85,25 +89,40 @@ def legs(template, count):
         yield mission(template, start, yaw_rad, goal, max_distance_m=40)
 
 
+def ahead(template, count):
+    """Way-points from the task's start at its heading (north)."""
+    rng = random.Random(1357)
+    for _ in range(count):
+        while True:
+            goal = point(rng)
+            if math.dist(START, goal) > MIN_APART_M:
+                break
+        yield mission(template, START, 0.0, goal)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('out_dir')
     parser.add_argument('--behind', type=int, default=30, help='way-points behind the start')
     parser.add_argument('--legs', type=int, default=40, help='legs from anywhere')
+    parser.add_argument('--ahead', type=int, default=120,
+                        help="way-points from the task's start at its heading")
     args = parser.parse_args()
-    if args.behind < 0 or args.legs < 0:
-        sys.exit('validation_missions.py: --behind and --legs must be >= 0')
+    if args.behind < 0 or args.legs < 0 or args.ahead < 0:
+        sys.exit('validation_missions.py: --behind, --legs and --ahead must be >= 0')
     with open(TEMPLATE) as f:
         template = f.read()
-    for name, prefix, texts in (('behind', 'b', behind(template, args.behind)),
-                                ('legs', 'l', legs(template, args.legs))):
+    sets = (('behind', 'b', behind(template, args.behind), args.behind),
+            ('legs', 'l', legs(template, args.legs), args.legs),
+            ('ahead', 'a', ahead(template, args.ahead), args.ahead))
+    for name, prefix, texts, _ in sets:
         folder = os.path.join(args.out_dir, name)
         os.makedirs(folder, exist_ok=True)
         for k, text in enumerate(texts):
             with open(os.path.join(folder, f'{prefix}{k}.yaml'), 'w') as f:
                 f.write(text)
-    print(f'wrote {args.behind} missions to {os.path.join(args.out_dir, "behind")} and '
-          f'{args.legs} to {os.path.join(args.out_dir, "legs")}')
+    print('wrote ' + ', '.join(f'{count} missions to {os.path.join(args.out_dir, name)}'
+                               for name, _, _, count in sets))
 
 
 if __name__ == '__main__':

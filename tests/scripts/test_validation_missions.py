@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""scripts/validation_missions.py: the two validation sets come out the same on every run, in
-the region, with the geometry each set promises (way-points straight behind the start; legs
-from anywhere at least 3 m long), and only the start, heading, way-point and distance limit
-differ from config/missions/test2.yaml.
+"""scripts/validation_missions.py: the three validation sets come out the same on every run,
+in the region, with the geometry each set promises (way-points straight behind the start; legs
+from anywhere at least 3 m long; way-points at least 3 m ahead of the start facing north), and
+only the start, heading, way-point and distance limit differ from config/missions/test2.yaml.
 
 Usage: test_validation_missions.py SCRIPT
 """
@@ -47,7 +47,7 @@ with tempfile.TemporaryDirectory() as tmp:
     check(result.returncode == 0, f'exit {result.returncode}: {result.stderr}')
     check(run(second).returncode == 0, 'second run failed')
     template = open(TEMPLATE).read()
-    for name, prefix, count in (('behind', 'b', 30), ('legs', 'l', 40)):
+    for name, prefix, count in (('behind', 'b', 30), ('legs', 'l', 40), ('ahead', 'a', 120)):
         files = sorted(os.listdir(os.path.join(first, name)))
         check(len(files) == count, f'{name}: {len(files)} files, expected {count}')
         for k in range(count):
@@ -70,6 +70,11 @@ with tempfile.TemporaryDirectory() as tmp:
                       f'{path}: heading {yaw} not straight away from bearing {bearing}')
                 check(math.hypot(goal[0], goal[1]) > 3.0, f'{path}: way-point too close')
                 check(len(changed) == 3, f'{path}: {len(changed)} lines changed, expected 3')
+            elif name == 'ahead':
+                check(start == [0.0, 0.0, 5.0], f'{path}: start {start}')
+                check(yaw == 0.0, f'{path}: heading {yaw}, expected north (0)')
+                check(math.dist(start, goal) > 3.0, f'{path}: way-point too close')
+                check(len(changed) == 3, f'{path}: {len(changed)} lines changed, expected 3')
             else:
                 for i, (lo, hi) in enumerate(REGION):
                     check(lo <= start[i] <= hi, f'{path}: start {start} outside the region')
@@ -82,12 +87,15 @@ with tempfile.TemporaryDirectory() as tmp:
     check('- position_ned_m: [7.249, -1.686, 1.398]' in b0, 'behind/b0.yaml: not the lab note\'s')
     l0 = open(os.path.join(first, 'legs', 'l0.yaml')).read()
     check(len(vector(l0, '- position_ned_m')) == 3, 'legs/l0.yaml: no way-point')
-    small = run(os.path.join(tmp, 'c'), '--behind', '2', '--legs', '0')
-    check(small.returncode == 0 and len(os.listdir(os.path.join(tmp, 'c', 'behind'))) == 2,
-          '--behind 2 --legs 0')
+    a0 = open(os.path.join(first, 'ahead', 'a0.yaml')).read()
+    check('- position_ned_m: [9.646, -1.494, 3.078]' in a0, 'ahead/a0.yaml: not the lab note\'s')
+    small = run(os.path.join(tmp, 'c'), '--behind', '2', '--legs', '0', '--ahead', '1')
+    check(small.returncode == 0 and len(os.listdir(os.path.join(tmp, 'c', 'behind'))) == 2 and
+          len(os.listdir(os.path.join(tmp, 'c', 'ahead'))) == 1, '--behind 2 --legs 0 --ahead 1')
     check(run(os.path.join(tmp, 'd'), '--legs', '-1').returncode != 0, '--legs -1 accepted')
+    check(run(os.path.join(tmp, 'e'), '--ahead', '-1').returncode != 0, '--ahead -1 accepted')
 
 if failures:
     print('\n'.join(failures))
     sys.exit(1)
-print('validation missions: 30 behind the start and 40 legs, the same on every run')
+print('validation missions: 30 behind the start, 40 legs and 120 ahead, the same on every run')
