@@ -38,7 +38,7 @@ def start_and_goal(path):
 
 
 def run(auvrl, mission, out_dir, controller_args):
-    """The mission's one way-point as (reached, time to reach s, energy)."""
+    """The mission's one way-point as (time to reach s, None if not reached; energy)."""
     os.makedirs(out_dir, exist_ok=True)
     done = subprocess.run([auvrl, 'eval', '--mission', mission, '--out', out_dir] +
                           controller_args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
@@ -47,8 +47,8 @@ def run(auvrl, mission, out_dir, controller_args):
         sys.exit(f'mission_lateness.py: {auvrl} eval --mission {mission} failed:\n{done.stderr}')
     with open(os.path.join(out_dir, 'mission.csv')) as f:
         row = next(csv.DictReader(f))
-    reached = row['reached'] == '1'
-    return reached, float(row['time_to_reach_s']) if reached else None, float(row['energy'])
+    return (float(row['time_to_reach_s']) if row['reached'] == '1' else None,
+            float(row['energy']))
 
 
 def summary(rows):
@@ -61,12 +61,12 @@ def summary(rows):
         mine = [r for r in rows if low <= r['depth_change_m'] < high]
         both = [r for r in mine if r['policy_time_s'] is not None and r['pid_time_s'] is not None]
         diffs = [r['policy_time_s'] - r['pid_time_s'] for r in both]
-        energy = sum(r['pid_energy'] for r in mine)
+        pid_energy = sum(r['pid_energy'] for r in mine)
+        mean_s = sum(diffs) / len(diffs) if diffs else float('nan')
+        ratio = sum(r['policy_energy'] for r in mine) / pid_energy if pid_energy else float('nan')
         lines.append(
             f'| {name} | {len(mine)} | {len(both)} | {sum(d >= 0 for d in diffs)} | '
-            f'{sum(d for d in diffs if d > 0):.1f} | '
-            f'{(sum(diffs) / len(diffs)) if diffs else float("nan"):+.2f} | '
-            f'{(sum(r["policy_energy"] for r in mine) / energy) if energy else float("nan"):.2f} |')
+            f'{sum(d for d in diffs if d > 0):.1f} | {mean_s:+.2f} | {ratio:.2f} |')
     return '\n'.join(lines)
 
 
@@ -84,13 +84,14 @@ def main():
     for mission in missions:
         name = os.path.splitext(os.path.basename(mission))[0]
         start, goal = start_and_goal(mission)
-        policy = run(args.auvrl, mission, os.path.join(args.out_dir, 'policy', name),
-                     ['--policy', args.policy])
-        pid = run(args.auvrl, mission, os.path.join(args.out_dir, 'pid', name),
-                  ['--controller', 'pid'])
+        policy_time_s, policy_energy = run(args.auvrl, mission,
+                                           os.path.join(args.out_dir, 'policy', name),
+                                           ['--policy', args.policy])
+        pid_time_s, pid_energy = run(args.auvrl, mission, os.path.join(args.out_dir, 'pid', name),
+                                     ['--controller', 'pid'])
         rows.append({'mission': name, 'depth_change_m': goal[2] - start[2],
-                     'policy_time_s': policy[1], 'pid_time_s': pid[1],
-                     'policy_energy': policy[2], 'pid_energy': pid[2]})
+                     'policy_time_s': policy_time_s, 'pid_time_s': pid_time_s,
+                     'policy_energy': policy_energy, 'pid_energy': pid_energy})
     with open(os.path.join(args.out_dir, 'lateness.csv'), 'w', newline='') as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
         writer.writeheader()
