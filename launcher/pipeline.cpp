@@ -4,8 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "agent/controller.hpp"
+#include "agent/pid_controller.hpp"
+#include "agent/pid_gains.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/process.hpp"
@@ -60,6 +64,41 @@ struct FinetuneBest {
   int iteration = 0;
 };
 
+/// objective_terms.csv in the run directory: the objective by price, on the fine-tuning's own
+/// way-points, of the PID baseline, the trained policy and the kept weights (when kept); the
+/// same as a table to out. Why a search keeps what it keeps: what each price weighs.
+void report_objective_terms(const FinetuneStageInput& in, const nn::Mlp& start,
+                            const std::optional<nn::Mlp>& kept, std::ostream& out) {
+  const std::vector<tuning::FinetuneEpisode> episodes =
+      tuning::objective_episodes(in.model, in.task, in.config, in.seed);
+  agent::PidController pid(in.model, agent::pid_gains_for(in.model).gains);
+  std::vector<ObjectiveTermsRow> rows;
+  rows.push_back(
+      {"pid", tuning::mean_objective_terms(in.model, in.task, pid, episodes, in.config)});
+  for (const auto& [name, net] : {std::pair<const char*, const nn::Mlp*>{"start", &start},
+                                  {"finetuned", kept ? &*kept : nullptr}}) {
+    if (net == nullptr) continue;
+    agent::PolicyController policy(*net, in.task);
+    rows.push_back(
+        {name, tuning::mean_objective_terms(in.model, in.task, policy, episodes, in.config)});
+  }
+  const std::string path = (fs::path(in.run_dir) / "objective_terms.csv").string();
+  try {
+    write_objective_terms(path, rows);
+  } catch (const std::exception&) {
+    out << "auvrl train: could not write " << path << "\n";
+  }
+  out << "  objective by price on its way-points [s]: arrival + hold + turn + flip + energy + "
+         "smoothness + lag = objective\n";
+  for (const ObjectiveTermsRow& r : rows) {
+    const tuning::ObjectiveTerms& t = r.terms;
+    out << fmt::format(
+        "    {:<9} {:.2f} + {:.2f} + {:.2f} + {:.2f} + {:.2f} + {:.2f} + {:.2f} = {:.2f}\n",
+        r.controller, t.arrival_s, t.hold_s, t.turn_s, t.flip_s, t.energy_s, t.smoothness_s,
+        t.lag_s, t.objective_s);
+  }
+}
+
 }  // namespace
 
 std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
@@ -108,6 +147,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       << "  validation before: " << describe(before) << "\n";
   if (!best.net) {
     out << "  not kept: no fine-tuned weights scored better on the validation way-points\n";
+    report_objective_terms(in, start, best.net, out);
     return start_path;
   }
   const std::string tuned_path = (fs::path(in.run_dir) / "policy_finetuned.nn").string();
@@ -115,6 +155,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   out << "  validation after:  " << describe(best.score) << " (iteration " << best.iteration
       << ")\n"
       << "  kept: " << tuned_path << "\n";
+  report_objective_terms(in, start, best.net, out);
   return tuned_path;
 }
 

@@ -116,6 +116,17 @@ void FinetuneSink::add(int iteration, double objective_s, double elapsed_s,
   writer_.end_row();
 }
 
+void write_objective_terms(const std::string& path, const std::vector<ObjectiveTermsRow>& rows) {
+  csv::Writer writer(path, {"controller", "objective_s", "arrival_s", "hold_s", "turn_s", "flip_s",
+                            "energy_s", "smoothness_s", "lag_s"});
+  for (const ObjectiveTermsRow& r : rows) {
+    const tuning::ObjectiveTerms& t = r.terms;
+    writer.row(r.controller, t.objective_s, t.arrival_s, t.hold_s, t.turn_s, t.flip_s, t.energy_s,
+               t.smoothness_s, t.lag_s);
+  }
+  writer.flush();
+}
+
 TrainingTelemetry::TrainingTelemetry(const std::string& run_dir)
     : episodes((fs::path(run_dir) / "episodes.csv").string()),
       learner((fs::path(run_dir) / "learner.csv").string()),

@@ -10,9 +10,11 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "common/csv.hpp"
 #include "eval/evaluation.hpp"
+#include "tuning/policy_finetune.hpp"
 
 namespace auvrl::launcher {
 
@@ -95,6 +97,16 @@ class FinetuneSink {
  private:
   csv::Writer writer_;
 };
+
+/// One controller's fine-tuning objective by price (objective_terms.csv).
+struct ObjectiveTermsRow {
+  std::string controller;  ///< pid, start (the trained policy) or finetuned
+  tuning::ObjectiveTerms terms;
+};
+
+/// Writes objective_terms.csv: one row per controller, each price's mean over the fine-tuning's
+/// way-points, s. Throws std::runtime_error naming the file when it cannot be written.
+void write_objective_terms(const std::string& path, const std::vector<ObjectiveTermsRow>& rows);
 
 /// The four files written while training, in run_dir.
 class TrainingTelemetry {

@@ -177,16 +177,6 @@ void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& ta
 
 namespace {
 
-/// energy_weight x the episode's thrust energy plus smoothness_weight x its command smoothness
-/// (the trajectory's rows are its steps), s.
-double thrust_price_s(const agent::EpisodeSummary& summary,
-                      const std::vector<agent::TrajectoryRow>& trajectory, double max_thrust_n,
-                      const FinetuneConfig& config) {
-  if (config.energy_weight == 0.0 && config.smoothness_weight == 0.0) return 0.0;
-  return config.energy_weight * summary.thrust_energy +
-         config.smoothness_weight * eval::trajectory_smoothness(trajectory, 0, max_thrust_n);
-}
-
 /// The search's direction from one iteration's objectives (value[s]: pair s / 2, sign + for
 /// even s) and the pairs' perturbations: rank shaping gives the lowest objective +0.5 and the
 /// highest -0.5 (robust to the scale and to the outliers of a way-point not reached), and the
@@ -218,9 +208,10 @@ Eigen::VectorXf rank_weighted_direction(const std::vector<double>& value,
 
 }  // namespace
 
-double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
-                         agent::Controller& controller, const FinetuneEpisode& episode,
-                         const FinetuneConfig& config, double reach_radius_m) {
+ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                       agent::Controller& controller,
+                                       const FinetuneEpisode& episode, const FinetuneConfig& config,
+                                       double reach_radius_m) {
   sim::VehicleModel plant = model;
   if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
   task::TaskConfig t = task;
@@ -241,14 +232,24 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
   const agent::EpisodeSummary summary = agent::run_episode(t, *link, controller, options);
 
   const double dt = plant.control_step_s;
+  ObjectiveTerms terms;
   double tilt_rad = 0.0;
   for (const agent::TrajectoryRow& row : trajectory) {
     tilt_rad = std::max({tilt_rad, std::abs(row.observation.euler_rpy_rad[0]),
                          std::abs(row.observation.euler_rpy_rad[1])});
   }
-  const double margin_s =
-      config.flip_margin_weight * std::max(0.0, tilt_rad - config.flip_margin_rad) +
-      thrust_price_s(summary, trajectory, plant.thruster_dynamics.max_thrust_n, config);
+  const double tilt_beyond_rad = std::max(0.0, tilt_rad - config.flip_margin_rad);
+  terms.flip_s = config.flip_margin_weight * tilt_beyond_rad;
+  double thrust_s = 0.0;
+  if (config.energy_weight != 0.0 || config.smoothness_weight != 0.0) {
+    const double smoothness =
+        eval::trajectory_smoothness(trajectory, 0, plant.thruster_dynamics.max_thrust_n);
+    terms.energy_s = config.energy_weight * summary.thrust_energy;
+    terms.smoothness_s = config.smoothness_weight * smoothness;
+    thrust_s = config.energy_weight * summary.thrust_energy + config.smoothness_weight * smoothness;
+  }
+  // Summed as the search has always summed them: the same weights give the same bytes.
+  const double margin_s = config.flip_margin_weight * tilt_beyond_rad + thrust_s;
   // Time behind the PID's arrival less the lead asked for, if any.
   auto lag_s = [&](double arrival_s) {
     if (!std::isfinite(episode.pid_arrival_s)) return 0.0;
@@ -266,7 +267,7 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
     }
     // Crossed during step k + 1: interpolate the moment the distance passed the radius.
     const double fraction = before > d ? (before - reach_radius_m) / (before - d) : 1.0;
-    const double arrival_s = (static_cast<double>(k) + std::clamp(fraction, 0.0, 1.0)) * dt;
+    terms.arrival_s = (static_cast<double>(k) + std::clamp(fraction, 0.0, 1.0)) * dt;
     double sum_m = 0.0;
     double turn_rad = 0.0;  // the heading's net change, unwrapped
     for (std::size_t j = k; j < trajectory.size(); ++j) {
@@ -277,12 +278,57 @@ double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig&
           std::remainder(yaw_rad - trajectory[j - 1].observation.euler_rpy_rad[2], 2.0 * kPi);
     }
     const auto n = static_cast<double>(trajectory.size() - k);
+    terms.hold_s = config.hold_weight * sum_m / n;
     // hold_turn_weight x the net turn per second of the hold.
-    return arrival_s + config.hold_weight * sum_m / n +
-           config.hold_turn_weight * std::abs(turn_rad) / (n * dt) + margin_s + lag_s(arrival_s);
+    terms.turn_s = config.hold_turn_weight * std::abs(turn_rad) / (n * dt);
+    terms.lag_s = lag_s(terms.arrival_s);
+    terms.objective_s = terms.arrival_s + terms.hold_s + terms.turn_s + margin_s + terms.lag_s;
+    return terms;
   }
   const double give_up_s = t.max_steps * dt;
-  return give_up_s + closest_m + margin_s + lag_s(give_up_s);
+  terms.arrival_s = give_up_s + closest_m;
+  terms.lag_s = lag_s(give_up_s);
+  terms.objective_s = terms.arrival_s + margin_s + terms.lag_s;
+  return terms;
+}
+
+double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
+                         agent::Controller& controller, const FinetuneEpisode& episode,
+                         const FinetuneConfig& config, double reach_radius_m) {
+  return arrival_objective_terms(model, task, controller, episode, config, reach_radius_m)
+      .objective_s;
+}
+
+std::vector<FinetuneEpisode> objective_episodes(const sim::VehicleModel& model,
+                                                const task::TaskConfig& task,
+                                                const FinetuneConfig& config, std::uint64_t seed) {
+  std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
+  if (config.pid_lag_weight > 0) set_pid_arrivals(model, task, config, episodes);
+  return episodes;
+}
+
+ObjectiveTerms mean_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                    agent::Controller& controller,
+                                    const std::vector<FinetuneEpisode>& episodes,
+                                    const FinetuneConfig& config) {
+  ObjectiveTerms mean;
+  for (const FinetuneEpisode& e : episodes) {
+    const ObjectiveTerms one = arrival_objective_terms(model, task, controller, e, config);
+    mean.arrival_s += one.arrival_s;
+    mean.hold_s += one.hold_s;
+    mean.turn_s += one.turn_s;
+    mean.flip_s += one.flip_s;
+    mean.energy_s += one.energy_s;
+    mean.smoothness_s += one.smoothness_s;
+    mean.lag_s += one.lag_s;
+    mean.objective_s += one.objective_s;
+  }
+  const auto n = static_cast<double>(std::max<std::size_t>(1, episodes.size()));
+  for (double* term : {&mean.arrival_s, &mean.hold_s, &mean.turn_s, &mean.flip_s, &mean.energy_s,
+                       &mean.smoothness_s, &mean.lag_s, &mean.objective_s}) {
+    *term /= n;
+  }
+  return mean;
 }
 
 FinetuneResult finetune_policy(
@@ -293,8 +339,7 @@ FinetuneResult finetune_policy(
   config.validate();
   // Throws if the network does not fit the task.
   { agent::PolicyController check(start, task); }
-  std::vector<FinetuneEpisode> episodes = finetune_episodes(task, config, seed);
-  if (config.pid_lag_weight > 0) set_pid_arrivals(model, task, config, episodes);
+  const std::vector<FinetuneEpisode> episodes = objective_episodes(model, task, config, seed);
   const auto t0 = std::chrono::steady_clock::now();
 
   int threads = config.threads > 0 ? config.threads

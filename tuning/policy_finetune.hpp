@@ -138,10 +138,46 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
 void set_pid_arrivals(const sim::VehicleModel& model, const task::TaskConfig& task,
                       const FinetuneConfig& config, std::vector<FinetuneEpisode>& episodes);
 
-/// The objective of one way-point (see FinetuneConfig::hold_weight), s, for a controller.
+/// The objective of one way-point split into its prices, each in s (FinetuneConfig says how
+/// each is priced): what a search trades against what, and why it keeps what it keeps.
+struct ObjectiveTerms {
+  /// The interpolated time to the reach radius; not reached, the episode's time plus the
+  /// closest approach (1 s per m).
+  double arrival_s = 0.0;
+  double hold_s = 0.0;        ///< hold_weight x the mean distance after the arrival
+  double turn_s = 0.0;        ///< hold_turn_weight x the heading's net change per second held
+  double flip_s = 0.0;        ///< flip_margin_weight x the tilt beyond flip_margin_rad
+  double energy_s = 0.0;      ///< energy_weight x the thrust energy
+  double smoothness_s = 0.0;  ///< smoothness_weight x the command smoothness
+  double lag_s = 0.0;  ///< pid_lag_weight x the arrival's lateness against the PID's less the lead
+  /// The objective, the sum of the prices as the search sums them (the parts, summed in another
+  /// order, may differ from it in the last digit).
+  double objective_s = 0.0;
+};
+
+/// The objective of one way-point (see FinetuneConfig::hold_weight), s, for a controller, by
+/// price.
+ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                       agent::Controller& controller,
+                                       const FinetuneEpisode& episode, const FinetuneConfig& config,
+                                       double reach_radius_m = 0.5);
+
+/// The objective of one way-point, s: arrival_objective_terms(...).objective_s.
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
                          agent::Controller& controller, const FinetuneEpisode& episode,
                          const FinetuneConfig& config, double reach_radius_m = 0.5);
+
+/// The fine-tuning's way-points for a run seed, with the PID's arrivals set when the lag is
+/// priced: what finetune_policy averages its objective over.
+std::vector<FinetuneEpisode> objective_episodes(const sim::VehicleModel& model,
+                                                const task::TaskConfig& task,
+                                                const FinetuneConfig& config, std::uint64_t seed);
+
+/// Each price's mean over the episodes for a controller, s.
+ObjectiveTerms mean_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                    agent::Controller& controller,
+                                    const std::vector<FinetuneEpisode>& episodes,
+                                    const FinetuneConfig& config);
 
 /// One iteration's figures.
 struct FinetuneIteration {

@@ -182,6 +182,16 @@ TEST(Launcher, AShortRunLearnsFarBeyondTheUntrainedPolicy) {
                                 std::regex(R"(\nfinetune:\n(?:[ ]+#.*\n)*  iterations: (\d+))")))
       << kPreset;
   EXPECT_EQ(finetune_lines, 1 + std::stoi(iterations[1])) << "the header and one row per iteration";
+  // Beside it, the objective by price: the PID's, the trained policy's, the kept weights'.
+  std::ifstream terms_csv(fs::path(dir) / "objective_terms.csv");
+  std::stringstream terms;
+  terms << terms_csv.rdbuf();
+  EXPECT_EQ(terms.str().rfind("controller,objective_s,", 0), 0u) << terms.str();
+  EXPECT_NE(terms.str().find("\npid,"), std::string::npos) << terms.str();
+  EXPECT_NE(terms.str().find("\nstart,"), std::string::npos) << terms.str();
+  EXPECT_EQ(terms.str().find("\nfinetuned,") != std::string::npos,
+            train.log().find("  kept: ") != std::string::npos)
+      << terms.str() << train.log();
 
   // The untrained policy: the same architecture, freshly initialised.
   const sim::VehicleModel model =

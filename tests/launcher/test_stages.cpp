@@ -129,9 +129,20 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   EXPECT_NE(out.str().find("fine-tuning " + options.run_dir + "/policy.nn"), std::string::npos)
       << out.str();
   for (const char* file : {"config.yaml", "finetune.csv", "eval/selected_policy.txt",
-                           "eval/robustness_comparison.md"}) {
+                           "eval/robustness_comparison.md", "objective_terms.csv"}) {
     EXPECT_TRUE(fs::exists(tmp / "again" / file)) << file;
   }
+  // The objective by price: the PID's, the trained policy's and, when kept, the fine-tuned
+  // weights' (two iterations do not beat the committed policy on the validation way-points).
+  std::ifstream terms(tmp / "again" / "objective_terms.csv");
+  std::vector<std::string> controllers;
+  for (std::string line; std::getline(terms, line);) {
+    controllers.push_back(line.substr(0, line.find(',')));
+  }
+  std::vector<std::string> expected{"controller", "pid", "start"};
+  if (out.str().find("  kept: ") != std::string::npos) expected.push_back("finetuned");
+  EXPECT_EQ(controllers, expected) << out.str();
+  EXPECT_NE(out.str().find("objective by price on its way-points"), std::string::npos) << out.str();
   std::ostringstream again;
   EXPECT_THROW(refinetune(o, again), std::invalid_argument);
   o.out_dir = (tmp / "other").string();

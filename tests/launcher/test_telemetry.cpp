@@ -135,6 +135,30 @@ TEST(TelemetryTest, FinetuneRowsLeaveTheValidationEmptyWhereNotValidated) {
             "10,30.5,25,38,25.25,0.08,1.125\n");
 }
 
+TEST(TelemetryTest, ObjectiveTermsARowPerControllerEveryPriceInSeconds) {
+  const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
+  tuning::ObjectiveTerms pid;
+  pid.arrival_s = 14.25;
+  pid.hold_s = 1.5;
+  pid.turn_s = 0.125;
+  pid.energy_s = 6.5;
+  pid.smoothness_s = 2.375;
+  pid.lag_s = 1.2;
+  pid.objective_s = 25.95;
+  tuning::ObjectiveTerms policy;
+  policy.arrival_s = 11.125;
+  policy.flip_s = 0.04;
+  policy.objective_s = 11.165;
+  write_objective_terms((dir / "objective_terms.csv").string(),
+                        {{"pid", pid}, {"finetuned", policy}});
+  EXPECT_EQ(slurp(dir / "objective_terms.csv"),
+            "controller,objective_s,arrival_s,hold_s,turn_s,flip_s,energy_s,smoothness_s,lag_s\n"
+            "pid,25.95,14.25,1.5,0.125,0,6.5,2.375,1.2\n"
+            "finetuned,11.165,11.125,0,0,0.04,0,0,0\n");
+  EXPECT_THROW(write_objective_terms((dir / "none" / "objective_terms.csv").string(), {}),
+               std::runtime_error);
+}
+
 TEST(TelemetryTest, AFileThatCannotBeWrittenStopsWithItsPathAndTheReason) {
   const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";

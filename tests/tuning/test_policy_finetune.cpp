@@ -1,7 +1,8 @@
 // Evolution-strategies fine-tuning (tuning/policy_finetune.hpp): its way-points, the per-way-point
 // objective against the evaluation's own figures (its PID lag term and its coarser integrator
 // too), that it lowers the objective of a trained policy, that the thread count does not change
-// the result, that bad settings are refused, and its prices of thrust energy and command changes.
+// the result, that bad settings are refused, its prices of thrust energy and command changes, and
+// the objective split into its prices.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "agent/pid_controller.hpp"
@@ -392,6 +394,93 @@ class IdleController final : public agent::Controller {
   }
   std::string name() const override { return "idle"; }
 };
+
+// Each price by itself: every one as its weight says, their sum the objective, and the means
+// over the fine-tuning's own way-points (with the PID's arrivals set) the means of the parts.
+TEST(ArrivalObjective, SplitsIntoItsPricesAsTheWeightsSay) {
+  const task::TaskConfig t = fast_task();
+  FinetuneConfig c;
+  c.episodes = 6;
+  c.episode_steps = 250;
+  c.hold_weight = 10.0;
+  c.hold_turn_weight = 20.0;
+  c.flip_margin_rad = 0.05;  // low enough that the PID's pitch on the way is priced
+  c.flip_margin_weight = 20.0;
+  c.energy_weight = 0.1;
+  c.smoothness_weight = 100.0;
+  c.pid_lag_weight = 4.0;
+  c.pid_lead_s = 0.3;
+  const std::vector<FinetuneEpisode> episodes = objective_episodes(nessie(), t, c, 7);
+  ASSERT_EQ(episodes.size(), 6u);
+  agent::PidController pid(nessie(), agent::pid_gains_for(nessie()).gains);
+  ObjectiveTerms sum;
+  bool flip_priced = false;
+  for (const FinetuneEpisode& e : episodes) {
+    ASSERT_TRUE(std::isfinite(e.pid_arrival_s));
+    const ObjectiveTerms one = arrival_objective_terms(nessie(), t, pid, e, c);
+    EXPECT_EQ(one.objective_s, arrival_objective(nessie(), t, pid, e, c));
+    EXPECT_NEAR(one.arrival_s + one.hold_s + one.turn_s + one.flip_s + one.energy_s +
+                    one.smoothness_s + one.lag_s,
+                one.objective_s, 1e-9);
+    EXPECT_GT(one.arrival_s, 0.0);
+    EXPECT_GT(one.hold_s, 0.0);
+    EXPECT_GT(one.energy_s, 0.0);
+    EXPECT_GT(one.smoothness_s, 0.0);
+    flip_priced = flip_priced || one.flip_s > 0.0;
+    // The PID arrives when it arrives: its lateness is the lead it is asked for.
+    EXPECT_NEAR(one.lag_s, 4.0 * 0.3, 1e-9);
+    // Each price alone is its weight times its figure: halving a weight halves its price.
+    FinetuneConfig half = c;
+    half.energy_weight = 0.05;
+    half.smoothness_weight = 50.0;
+    half.hold_weight = 5.0;
+    const ObjectiveTerms halved = arrival_objective_terms(nessie(), t, pid, e, half);
+    EXPECT_NEAR(halved.energy_s, one.energy_s / 2.0, 1e-12);
+    EXPECT_NEAR(halved.smoothness_s, one.smoothness_s / 2.0, 1e-12);
+    EXPECT_NEAR(halved.hold_s, one.hold_s / 2.0, 1e-12);
+    EXPECT_EQ(halved.arrival_s, one.arrival_s);
+    for (auto [total, part] : {std::pair{&sum.arrival_s, one.arrival_s},
+                               {&sum.hold_s, one.hold_s},
+                               {&sum.turn_s, one.turn_s},
+                               {&sum.flip_s, one.flip_s},
+                               {&sum.energy_s, one.energy_s},
+                               {&sum.smoothness_s, one.smoothness_s},
+                               {&sum.lag_s, one.lag_s},
+                               {&sum.objective_s, one.objective_s}}) {
+      *total += part;
+    }
+  }
+  EXPECT_TRUE(flip_priced);
+  const ObjectiveTerms mean = mean_objective_terms(nessie(), t, pid, episodes, c);
+  EXPECT_NEAR(mean.arrival_s, sum.arrival_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.hold_s, sum.hold_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.turn_s, sum.turn_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.flip_s, sum.flip_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.energy_s, sum.energy_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.smoothness_s, sum.smoothness_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.lag_s, sum.lag_s / 6.0, 1e-12);
+  EXPECT_NEAR(mean.objective_s, sum.objective_s / 6.0, 1e-12);
+  // Without a lag price the way-points carry no PID arrival, and nothing is charged for it.
+  c.pid_lag_weight = 0.0;
+  for (const FinetuneEpisode& e : objective_episodes(nessie(), t, c, 7)) {
+    EXPECT_TRUE(std::isnan(e.pid_arrival_s));
+    EXPECT_EQ(arrival_objective_terms(nessie(), t, pid, e, c).lag_s, 0.0);
+  }
+}
+
+// Not arriving: the arrival's price is the episode's time plus the closest approach, no hold.
+TEST(ArrivalObjective, NotArrivingPricesNoHold) {
+  FinetuneConfig c;
+  c.episode_steps = 100;
+  FinetuneEpisode e;
+  e.goal_ned_m = Eigen::Vector3d(5.0, 0.0, 5.0);
+  IdleController idle;
+  const ObjectiveTerms terms = arrival_objective_terms(nessie(), fast_task(), idle, e, c);
+  EXPECT_NEAR(terms.arrival_s, 10.0 + 5.0, 0.05);
+  EXPECT_EQ(terms.hold_s, 0.0);
+  EXPECT_EQ(terms.turn_s, 0.0);
+  EXPECT_EQ(terms.objective_s, arrival_objective(nessie(), fast_task(), idle, e, c));
+}
 
 TEST(ArrivalObjective, NotArrivingCostsTheEpisodeTimePlusTheClosestApproach) {
   FinetuneEpisode e;
