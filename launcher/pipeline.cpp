@@ -64,11 +64,11 @@ struct FinetuneBest {
   int iteration = 0;
 };
 
-/// objective_terms.csv in the run directory: the objective by price, on the fine-tuning's own
-/// way-points, of the PID baseline, the trained policy and the kept weights (when kept); the
-/// same as a table to out. Why a search keeps what it keeps: what each price weighs.
-void report_objective_terms(const FinetuneStageInput& in, const nn::Mlp& start,
-                            const std::optional<nn::Mlp>& kept, std::ostream& out) {
+/// The objective by price, on the fine-tuning's own way-points, of the PID baseline, the trained
+/// policy and the kept weights (when kept).
+std::vector<ObjectiveTermsRow> objective_terms_rows(const FinetuneStageInput& in,
+                                                    const nn::Mlp& start,
+                                                    const std::optional<nn::Mlp>& kept) {
   const std::vector<tuning::FinetuneEpisode> episodes =
       tuning::objective_episodes(in.model, in.task, in.config, in.seed);
   agent::PidController pid(in.model, agent::pid_gains_for(in.model).gains);
@@ -82,11 +82,22 @@ void report_objective_terms(const FinetuneStageInput& in, const nn::Mlp& start,
     rows.push_back(
         {name, tuning::mean_objective_terms(in.model, in.task, policy, episodes, in.config)});
   }
+  return rows;
+}
+
+/// objective_terms.csv in the run directory (objective_terms_rows) and the same as a table to
+/// out: why a search keeps what it keeps, what each price weighs. A report only: a failure is
+/// said and the stage's policy stays.
+void report_objective_terms(const FinetuneStageInput& in, const nn::Mlp& start,
+                            const std::optional<nn::Mlp>& kept, std::ostream& out) {
   const std::string path = (fs::path(in.run_dir) / "objective_terms.csv").string();
+  std::vector<ObjectiveTermsRow> rows;
   try {
+    rows = objective_terms_rows(in, start, kept);
     write_objective_terms(path, rows);
-  } catch (const std::exception&) {
-    out << "auvrl train: could not write " << path << "\n";
+  } catch (const std::exception& e) {
+    out << "auvrl train: could not write " << path << ": " << e.what() << "\n";
+    if (rows.empty()) return;
   }
   out << "  objective by price on its way-points [s]: arrival + hold + turn + flip + energy + "
          "smoothness + lag = objective\n";

@@ -1,8 +1,9 @@
 // What a training run writes as it goes, each through the project's CSV writer: episodes.csv
 // (one row per episode report), learner.csv (the learner's figures), progress.csv (the status
 // line's figures, once a second), quick_eval.csv (every quick evaluation), finetune.csv (the
-// fine-tuning's iterations) and objective_terms.csv (the fine-tuning's objective by price). Rows are appended over --resume. Columns and number formats are
-// the run directory's interface to scripts/plot_run.py and the tests: keep them.
+// fine-tuning's iterations) and objective_terms.csv (the fine-tuning's objective by price,
+// written whole once the fine-tuning ends). Rows are appended over --resume. Columns and number
+// formats are the run directory's interface to scripts/plot_run.py and the tests: keep them.
 #pragma once
 
 #include <auvrl_lcm/episode_report_t.hpp>

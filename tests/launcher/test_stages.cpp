@@ -150,6 +150,31 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   EXPECT_THROW(refinetune(o, again), std::invalid_argument);
 }
 
+// objective_terms.csv is a report: when it cannot be written the stage says so and goes on,
+// the fine-tuning's result as it would be otherwise.
+TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  prepare_run_directory(options);
+  const std::string policy = (tmp / "run" / "policy.nn").string();
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
+  RunContext ctx = load_run_context(options, ContextUse::kAfterTraining);
+  ctx.rc.finetune.iterations = 2;
+  ctx.run_dir = (tmp / "stage").string();
+  fs::create_directories(tmp / "stage" / "objective_terms.csv");  // a folder: not writable
+  std::ostringstream out;
+  const std::string kept = finetune_if_configured(ctx, policy, out, false);
+  EXPECT_NE(out.str().find("could not write " + ctx.run_dir + "/objective_terms.csv"),
+            std::string::npos)
+      << out.str();
+  EXPECT_EQ(out.str().find("fine-tuning failed"), std::string::npos) << out.str();
+  EXPECT_TRUE(kept == policy || kept == ctx.run_dir + "/policy_finetuned.nn") << kept;
+  EXPECT_TRUE(fs::exists(kept));
+  EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
+}
+
 using RolesTest = test_support::RolesFixture;
 
 TEST_F(RolesTest, StartOrderKindsAndLogs) {
