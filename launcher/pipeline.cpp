@@ -64,13 +64,11 @@ struct FinetuneBest {
   int iteration = 0;
 };
 
-/// The objective by price, on the fine-tuning's own way-points, of the PID baseline, the trained
-/// policy and the kept weights (when kept).
-std::vector<ObjectiveTermsRow> objective_terms_rows(const FinetuneStageInput& in,
-                                                    const nn::Mlp& start,
-                                                    const std::optional<nn::Mlp>& kept) {
-  const std::vector<tuning::FinetuneEpisode> episodes =
-      tuning::objective_episodes(in.model, in.task, in.config, in.seed);
+/// The objective by price, on the fine-tuning's own way-points (episodes), of the PID baseline,
+/// the trained policy and the kept weights (when kept).
+std::vector<ObjectiveTermsRow> objective_terms_rows(
+    const FinetuneStageInput& in, const std::vector<tuning::FinetuneEpisode>& episodes,
+    const nn::Mlp& start, const std::optional<nn::Mlp>& kept) {
   agent::PidController pid(in.model, agent::pid_gains_for(in.model).gains);
   std::vector<ObjectiveTermsRow> rows;
   rows.push_back(
@@ -88,12 +86,14 @@ std::vector<ObjectiveTermsRow> objective_terms_rows(const FinetuneStageInput& in
 /// objective_terms.csv in the run directory (objective_terms_rows) and the same as a table to
 /// out: why a search keeps what it keeps, what each price weighs. A report only: a failure is
 /// said and the stage's policy stays.
-void report_objective_terms(const FinetuneStageInput& in, const nn::Mlp& start,
-                            const std::optional<nn::Mlp>& kept, std::ostream& out) {
+void report_objective_terms(const FinetuneStageInput& in,
+                            const std::vector<tuning::FinetuneEpisode>& episodes,
+                            const nn::Mlp& start, const std::optional<nn::Mlp>& kept,
+                            std::ostream& out) {
   const std::string path = (fs::path(in.run_dir) / "objective_terms.csv").string();
   std::vector<ObjectiveTermsRow> rows;
   try {
-    rows = objective_terms_rows(in, start, kept);
+    rows = objective_terms_rows(in, episodes, start, kept);
     write_objective_terms(path, rows);
   } catch (const std::exception& e) {
     out << "auvrl train: could not write " << path << ": " << e.what() << "\n";
@@ -158,7 +158,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       << "  validation before: " << describe(before) << "\n";
   if (!best.net) {
     out << "  not kept: no fine-tuned weights scored better on the validation way-points\n";
-    report_objective_terms(in, start, best.net, out);
+    report_objective_terms(in, result.episodes, start, best.net, out);
     return start_path;
   }
   const std::string tuned_path = (fs::path(in.run_dir) / "policy_finetuned.nn").string();
@@ -166,7 +166,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   out << "  validation after:  " << describe(best.score) << " (iteration " << best.iteration
       << ")\n"
       << "  kept: " << tuned_path << "\n";
-  report_objective_terms(in, start, best.net, out);
+  report_objective_terms(in, result.episodes, start, best.net, out);
   return tuned_path;
 }
 

@@ -307,27 +307,35 @@ std::vector<FinetuneEpisode> objective_episodes(const sim::VehicleModel& model,
   return episodes;
 }
 
+ObjectiveTerms& ObjectiveTerms::operator+=(const ObjectiveTerms& o) {
+  arrival_s += o.arrival_s;
+  hold_s += o.hold_s;
+  turn_s += o.turn_s;
+  flip_s += o.flip_s;
+  energy_s += o.energy_s;
+  smoothness_s += o.smoothness_s;
+  lag_s += o.lag_s;
+  objective_s += o.objective_s;
+  return *this;
+}
+
+ObjectiveTerms& ObjectiveTerms::operator/=(double divisor) {
+  for (double* term :
+       {&arrival_s, &hold_s, &turn_s, &flip_s, &energy_s, &smoothness_s, &lag_s, &objective_s}) {
+    *term /= divisor;
+  }
+  return *this;
+}
+
 ObjectiveTerms mean_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
                                     agent::Controller& controller,
                                     const std::vector<FinetuneEpisode>& episodes,
                                     const FinetuneConfig& config) {
   ObjectiveTerms mean;
   for (const FinetuneEpisode& e : episodes) {
-    const ObjectiveTerms one = arrival_objective_terms(model, task, controller, e, config);
-    mean.arrival_s += one.arrival_s;
-    mean.hold_s += one.hold_s;
-    mean.turn_s += one.turn_s;
-    mean.flip_s += one.flip_s;
-    mean.energy_s += one.energy_s;
-    mean.smoothness_s += one.smoothness_s;
-    mean.lag_s += one.lag_s;
-    mean.objective_s += one.objective_s;
+    mean += arrival_objective_terms(model, task, controller, e, config);
   }
-  const auto n = static_cast<double>(std::max<std::size_t>(1, episodes.size()));
-  for (double* term : {&mean.arrival_s, &mean.hold_s, &mean.turn_s, &mean.flip_s, &mean.energy_s,
-                       &mean.smoothness_s, &mean.lag_s, &mean.objective_s}) {
-    *term /= n;
-  }
+  mean /= static_cast<double>(std::max<std::size_t>(1, episodes.size()));
   return mean;
 }
 
@@ -361,7 +369,7 @@ FinetuneResult finetune_policy(
     return sum / static_cast<double>(episodes.size());
   };
 
-  FinetuneResult result{start, 0.0, 0.0, 0, {}};
+  FinetuneResult result{start, 0.0, 0.0, 0, {}, episodes};
   Eigen::VectorXf theta = start.params();
   const Eigen::Index p = theta.size();
   result.start_objective = objective(workers[0], theta);

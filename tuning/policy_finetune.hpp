@@ -153,6 +153,10 @@ struct ObjectiveTerms {
   /// The objective, the sum of the prices as the search sums them (the parts, summed in another
   /// order, may differ from it in the last digit).
   double objective_s = 0.0;
+
+  /// Price by price, for sums and means over way-points.
+  ObjectiveTerms& operator+=(const ObjectiveTerms& other);
+  ObjectiveTerms& operator/=(double divisor);
 };
 
 /// The objective of one way-point (see FinetuneConfig::hold_weight), s, for a controller, by
@@ -193,6 +197,8 @@ struct FinetuneResult {
   double best_objective = 0.0;   ///< network's, s
   int best_iteration = 0;        ///< 0: no iteration improved on the start
   std::vector<FinetuneIteration> iterations;
+  /// The way-points the objective averaged over (objective_episodes), for reports on the same.
+  std::vector<FinetuneEpisode> episodes;
 };
 
 /// Fine-tunes `start` (an actor network for the task's layout) for the task; deterministic for

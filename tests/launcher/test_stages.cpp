@@ -29,6 +29,15 @@ bool has(const std::vector<std::string>& argv, const std::vector<std::string>& r
   return std::search(argv.begin(), argv.end(), run.begin(), run.end()) != argv.end();
 }
 
+/// A new run directory tmp/run for the fast preset, as `auvrl train` prepares it.
+TrainOptions fast_run_directory(const fs::path& tmp) {
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  prepare_run_directory(options);
+  return options;
+}
+
 TEST(RunDirectoryTest, ANewRunGetsItsFoldersAndAConfigCopyWithAnAbsoluteVehicle) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_rundir_");
   TrainOptions options;
@@ -70,10 +79,7 @@ TEST(RunDirectoryTest, OnlyFinishedCheckpointsCount) {
 // robustness suite for both controllers, and the comparison table the report includes.
 TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_evalstage_");
-  TrainOptions options;
-  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  options.run_dir = (tmp / "run").string();
-  prepare_run_directory(options);
+  const TrainOptions options = fast_run_directory(tmp);
   const RunContext ctx = load_run_context(options);
   std::ostringstream out;
   const EvaluationResult result =
@@ -105,10 +111,7 @@ TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
 // evaluated there; an output directory in use is refused.
 TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  TrainOptions options;
-  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  options.run_dir = (tmp / "run").string();
-  prepare_run_directory(options);
+  const TrainOptions options = fast_run_directory(tmp);
   fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", tmp / "run" / "policy.nn");
   RefinetuneOptions o;
   o.run_dir = options.run_dir;
@@ -154,10 +157,7 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
 // the fine-tuning's result as it would be otherwise.
 TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  TrainOptions options;
-  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  options.run_dir = (tmp / "run").string();
-  prepare_run_directory(options);
+  const TrainOptions options = fast_run_directory(tmp);
   const std::string policy = (tmp / "run" / "policy.nn").string();
   fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
   RunContext ctx = load_run_context(options, ContextUse::kAfterTraining);
