@@ -326,9 +326,13 @@ int run_finetune_command(int argc, const char* const* argv) {
              "the policy to fine-tune (default: the one the run's evaluation used)");
   cli.option("iterations", &options.iterations, "fine-tuning iterations (default: the config's)");
   cli.option("seed", &options.seed, "seed of the fine-tuning's way-points (default: the run's)");
+  cli.option("candidates", &options.candidates,
+             "searches, each with its own seed; the one passing the most robustness groups at\n"
+             "finetune.selection_seed is kept (default: the config's)");
   cli.flag("keep-iterates", &options.keep_iterates,
            "also write the weights validated every 10 iterations (and the last) to\n"
-           "OUT/iterates/iteration_NNN.nn, to evaluate the fine-tuning's course");
+           "OUT/iterates/iteration_NNN.nn (candidate K's to OUT/iterates_candidateK/), to\n"
+           "evaluate the fine-tuning's course");
   if (!cli.parse(argc, argv)) return 0;
   return auvrl::launcher::refinetune(options, std::cout);
 }

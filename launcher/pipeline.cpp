@@ -16,6 +16,7 @@
 #include "common/signals.hpp"
 #include "eval/ranking.hpp"
 #include "launcher/format.hpp"
+#include "tuning/candidate_selection.hpp"
 #include "tuning/policy_finetune.hpp"
 
 namespace auvrl::launcher {
@@ -110,23 +111,39 @@ void report_objective_terms(const FinetuneStageInput& in,
   }
 }
 
-}  // namespace
+/// One search of the fine-tuning: its seed, the best validated weights (none: not kept) and
+/// what the search did.
+struct CandidateSearch {
+  std::uint64_t seed = 0;
+  FinetuneBest best;
+  tuning::FinetuneResult result;
+};
 
-std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
-                           std::ostream& out) {
+/// A file of candidate `index` (from 0) in the run directory: the first candidate's under the
+/// name itself (as with one search), candidate i + 1's with "_candidate<i + 1>" before the
+/// extension.
+fs::path candidate_path(const FinetuneStageInput& in, const std::string& stem,
+                        const std::string& extension, int index) {
+  const std::string suffix = index == 0 ? "" : fmt::format("_candidate{}", index + 1);
+  return fs::path(in.run_dir) / (stem + suffix + extension);
+}
+
+/// Runs candidate `index`'s search from `start` (validated as `before`), its progress to its
+/// finetune.csv, validating every validate_every iterations and at the end.
+CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& start,
+                                 const eval::ValidationScore& before, int index,
+                                 std::ostream& out) {
   constexpr int validate_every = 10;
-  const nn::Mlp start = nn::network_from_bytes(nn::read_file(start_path), 1);
-  out << fmt::format(
-      "auvrl train: fine-tuning {} (evolution strategies, {} iterations of {} policies on {} "
-      "way-points)\n",
-      start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes);
-  const eval::ValidationScore before = in.validation.evaluate(start);
   const eval::Ranking ranking = finetune_ranking(in.config, in.max_hold_m);
+  const std::uint64_t seed = tuning::candidate_seed(in.seed, index);
   FinetuneBest best{before, std::nullopt, 0};
-  FinetuneSink csv((fs::path(in.run_dir) / "finetune.csv").string());
+  FinetuneSink csv(candidate_path(in, "finetune", ".csv", index).string());
   // Made once, before the search: a folder that cannot be made fails before its work.
-  const fs::path iterates = fs::path(in.run_dir) / "iterates";
+  const fs::path iterates = candidate_path(in, "iterates", "", index);
   if (in.keep_iterates) fs::create_directories(iterates);
+  const std::string label = in.config.candidates == 1
+                                ? std::string()
+                                : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
     if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations) {
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
@@ -140,25 +157,85 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
     if (eval::ranks_above(score, best.score, ranking)) best = {score, weights, it.iteration};
     out << fmt::format(
-        "auvrl train: fine-tuning {}/{}  objective {:.3f} s  validation {}/{} mean {:.2f} s  "
+        "auvrl train: fine-tuning{} {}/{}  objective {:.3f} s  validation {}/{} mean {:.2f} s  "
         "elapsed {}\n",
-        it.iteration, in.config.iterations, it.objective, score.reached, score.episodes,
+        label, it.iteration, in.config.iterations, it.objective, score.reached, score.episodes,
         score.mean_time_s, format_duration(it.elapsed_s));
   };
-  const tuning::FinetuneResult result =
-      tuning::finetune_policy(in.model, in.task, start, in.config, in.seed, progress,
+  tuning::FinetuneResult result =
+      tuning::finetune_policy(in.model, in.task, start, in.config, seed, progress,
                               [] { return signals::stop_requested(); });
   try {
     csv.writer().flush();
   } catch (const std::exception&) {
     out << "auvrl train: could not write " << csv.writer().path() << "\n";
   }
+  return CandidateSearch{seed, std::move(best), std::move(result)};
+}
+
+/// Runs every candidate's search and returns the one to keep: with one, it; with more, the one
+/// whose kept weights (or the start, where a search kept none) pass the most robustness groups
+/// at the selection seed (candidates.csv has each). A search that fails after the first is
+/// said and the choice made among those done; Ctrl-C ends the searches after the one under way.
+CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
+                                  const eval::ValidationScore& before, std::ostream& out) {
+  if (in.config.candidates == 1) return search_candidate(in, start, before, 0, out);
+  const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
+  std::vector<CandidateSearch> searches;
+  std::vector<CandidatesRow> rows;
+  for (int index = 0; index < in.config.candidates; ++index) {
+    if (index > 0 && signals::stop_requested()) break;
+    try {
+      searches.push_back(search_candidate(in, start, before, index, out));
+    } catch (const std::exception& e) {
+      if (searches.empty()) throw;
+      out << "auvrl train: fine-tuning candidate " << index + 1 << " failed: " << e.what()
+          << "; choosing among the first " << searches.size() << "\n";
+      break;
+    }
+    const CandidateSearch& c = searches.back();
+    const int passing = selector.groups_passing(c.best.net ? *c.best.net : start);
+    rows.push_back({index + 1, c.seed, c.best.iteration, c.result.best_objective, passing,
+                    selector.groups(), false});
+    out << fmt::format(
+        "auvrl train: fine-tuning candidate {}/{} (seed {}): objective {:.3f} s, {} of {} "
+        "robustness groups at seed {}\n",
+        index + 1, in.config.candidates, c.seed, c.result.best_objective, passing,
+        selector.groups(), in.config.selection_seed);
+  }
+  std::vector<int> passing;
+  for (const CandidatesRow& r : rows) passing.push_back(r.groups_passing);
+  const std::size_t chosen = tuning::choose_candidate(passing);
+  rows[chosen].chosen = true;
+  const std::string path = (fs::path(in.run_dir) / "candidates.csv").string();
+  try {
+    write_candidates(path, rows);
+  } catch (const std::exception& e) {
+    out << "auvrl train: could not write " << path << ": " << e.what() << "\n";
+  }
+  out << "auvrl train: fine-tuning: candidate " << chosen + 1 << " chosen\n";
+  return std::move(searches[chosen]);
+}
+
+}  // namespace
+
+std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
+                           std::ostream& out) {
+  const nn::Mlp start = nn::network_from_bytes(nn::read_file(start_path), 1);
+  out << fmt::format(
+      "auvrl train: fine-tuning {} (evolution strategies, {} iterations of {} policies on {} "
+      "way-points{})\n",
+      start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes,
+      in.config.candidates == 1 ? "" : fmt::format("; {} candidates", in.config.candidates));
+  const eval::ValidationScore before = in.validation.evaluate(start);
+  const CandidateSearch search = search_candidates(in, start, before, out);
+  const FinetuneBest& best = search.best;
   out << fmt::format("auvrl train: fine-tuned: objective {:.3f} -> {:.3f} s\n",
-                     result.start_objective, result.best_objective)
+                     search.result.start_objective, search.result.best_objective)
       << "  validation before: " << describe(before) << "\n";
   if (!best.net) {
     out << "  not kept: no fine-tuned weights scored better on the validation way-points\n";
-    report_objective_terms(in, result.episodes, start, best.net, out);
+    report_objective_terms(in, search.result.episodes, start, best.net, out);
     return start_path;
   }
   const std::string tuned_path = (fs::path(in.run_dir) / "policy_finetuned.nn").string();
@@ -166,7 +243,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   out << "  validation after:  " << describe(best.score) << " (iteration " << best.iteration
       << ")\n"
       << "  kept: " << tuned_path << "\n";
-  report_objective_terms(in, result.episodes, start, best.net, out);
+  report_objective_terms(in, search.result.episodes, start, best.net, out);
   return tuned_path;
 }
 

@@ -30,8 +30,9 @@ struct FinetuneStageInput {
   double max_hold_m = 0.15;                ///< the ranking's hold limit, m
   std::string run_dir;
   /// When true, the weights scored on the validation way-points are also written to
-  /// run_dir/iterates/iteration_NNN.nn (the iteration's number, three digits at least), for
-  /// evaluating how the fine-tuning went beyond what it keeps.
+  /// run_dir/iterates/iteration_NNN.nn (the iteration's number, three digits at least;
+  /// candidate K's to iterates_candidateK/), for evaluating how the fine-tuning went beyond what
+  /// it keeps.
   bool keep_iterates = false;
 };
 
@@ -39,7 +40,10 @@ struct FinetuneStageInput {
 /// policy to keep. The weights are scored on validation way-points every validate_every
 /// iterations and at the end; the best of them, if better than the start there, is written to
 /// policy_finetuned.nn and kept. (The fine-tuning's own way-points are few: a step that lowers
-/// their objective can lose a way-point elsewhere.) Ctrl-C ends it after the iteration under
+/// their objective can lose a way-point elsewhere.) With finetune.candidates > 1 the searches
+/// run one after another (candidate K's progress to finetune_candidateK.csv), and the one whose
+/// kept weights pass the most robustness groups at finetune.selection_seed is kept
+/// (candidates.csv; tuning/candidate_selection.hpp). Ctrl-C ends it after the iteration under
 /// way.
 std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
                            std::ostream& out);

@@ -18,6 +18,7 @@ struct RefinetuneOptions {
   std::string policy_path;  ///< "": the policy the run's evaluation named, else RUN/policy.nn
   std::string out_dir;      ///< created (or empty): finetune.csv, policy_finetuned.nn, eval/
   int iterations = -1;      ///< overrides finetune.iterations when >= 0
+  int candidates = 0;       ///< overrides finetune.candidates when >= 1
   std::int64_t seed = -1;   ///< overrides run.seed (the fine-tuning's way-points) when >= 0
   std::string source_dir;   ///< the source tree (scripts/ for the plots)
   /// Also write every validated iterate to out_dir/iterates/ (FinetuneStageInput::keep_iterates).

@@ -96,6 +96,11 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "of the others, with sensor noise only (finetune.randomise's levels and scale)");
   add_objective_fields(t);
   t.field("threads", &C::threads, "0: one per CPU", "policies evaluated at once");
+  t.field("candidates", &C::candidates, "searches",
+          "searches from the trained policy, each with its own seed; the kept one passes the "
+          "most robustness groups at selection_seed");
+  t.field("selection_seed", &C::selection_seed, "not 1",
+          "the robustness suite's draw that chooses among the candidates");
   return t;
 }
 

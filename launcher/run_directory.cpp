@@ -74,6 +74,8 @@ void write_readme(const std::string& run_dir) {
         << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
         << "  policy_finetuned.nn, finetune.csv   the fine-tuned policy and its progress\n"
         << "  objective_terms.csv   the fine-tuning's objective by price: PID, trained, kept\n"
+        << "  candidates.csv, finetune_candidateK.csv   with finetune.candidates > 1: each\n"
+           "                    search's robustness groups, the one kept, and its progress\n"
         << "  quick_eval.csv    every quick evaluation (reached, mean time, hold error, worst\n"
            "                    time ratio to the PID's on the same way-points, kept)\n"
         << "  eval/, plots/, report.md   evaluation of the policy and the PID baseline\n"

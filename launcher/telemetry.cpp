@@ -127,6 +127,16 @@ void write_objective_terms(const std::string& path, const std::vector<ObjectiveT
   writer.flush();
 }
 
+void write_candidates(const std::string& path, const std::vector<CandidatesRow>& rows) {
+  csv::Writer writer(path, {"candidate", "seed", "kept_iteration", "objective_s", "groups_passing",
+                            "groups", "chosen"});
+  for (const CandidatesRow& r : rows) {
+    writer.row(r.candidate, r.seed, r.kept_iteration, r.objective_s, r.groups_passing, r.groups,
+               r.chosen ? 1 : 0);
+  }
+  writer.flush();
+}
+
 TrainingTelemetry::TrainingTelemetry(const std::string& run_dir)
     : episodes((fs::path(run_dir) / "episodes.csv").string()),
       learner((fs::path(run_dir) / "learner.csv").string()),

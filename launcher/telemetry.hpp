@@ -109,6 +109,21 @@ struct ObjectiveTermsRow {
 /// way-points, s. Throws std::runtime_error naming the file when it cannot be written.
 void write_objective_terms(const std::string& path, const std::vector<ObjectiveTermsRow>& rows);
 
+/// One fine-tuning candidate (candidates.csv).
+struct CandidatesRow {
+  int candidate = 0;         ///< from 1
+  std::uint64_t seed = 0;    ///< its search's seed
+  int kept_iteration = 0;    ///< the validated iteration it kept; 0: none (the trained policy)
+  double objective_s = 0.0;  ///< the lowest mean objective its search saw, s
+  int groups_passing = 0;    ///< robustness groups passing against the PID at the selection seed
+  int groups = 0;            ///< the suite's groups
+  bool chosen = false;       ///< the one kept
+};
+
+/// Writes candidates.csv: one row per candidate. Throws std::runtime_error naming the file when
+/// it cannot be written.
+void write_candidates(const std::string& path, const std::vector<CandidatesRow>& rows);
+
 /// The four files written while training, in run_dir.
 class TrainingTelemetry {
  public:

@@ -90,6 +90,10 @@ void FinetuneConfig::validate() const {
           "smoothness_weight must be >= 0");
   require(integration_substeps >= 0, "integration_substeps must be >= 0");
   require(threads >= 0, "threads must be >= 0");
+  require(candidates >= 1 && candidates <= 64, "candidates must be in [1, 64]");
+  require(selection_seed != eval::EvaluationConfig{}.seed,
+          "selection_seed must not be " + std::to_string(eval::EvaluationConfig{}.seed) +
+              ", the evaluation's own draw of the robustness suite");
   require(randomised_fraction >= 0 && randomised_fraction <= 1,
           "randomised_fraction must be in [0, 1]");
   require(noisy_fraction >= 0 && noisy_fraction <= 1, "noisy_fraction must be in [0, 1]");

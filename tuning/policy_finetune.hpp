@@ -111,6 +111,14 @@ struct FinetuneConfig {
   double energy_weight = 0.0;
   double smoothness_weight = 0.0;
   int threads = 2;  ///< policies evaluated at once (0: one per CPU)
+  /// Searches from the same trained policy, one after another, each with a seed of its own
+  /// (tuning::candidate_seed: the first is the run's); of their kept weights the pipeline keeps
+  /// those that pass the most robustness groups against the PID at selection_seed
+  /// (tuning/candidate_selection.hpp). 1: one search, no choice.
+  int candidates = 1;
+  /// The robustness suite's draw that chooses among the candidates: a validation draw of the
+  /// fine-tuning's own, never the evaluation's (seed 1).
+  std::uint64_t selection_seed = 7890;
 
   /// Throws std::invalid_argument naming the first setting out of range.
   void validate() const;

@@ -1,5 +1,6 @@
 // The stages that run in process: the run directory, the processes' command lines, and the
 // evaluation stage (the scenarios and the robustness suite of the policy and the PID).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -173,6 +174,47 @@ TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
   EXPECT_TRUE(kept == policy || kept == ctx.run_dir + "/policy_finetuned.nn") << kept;
   EXPECT_TRUE(fs::exists(kept));
   EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
+}
+
+// With candidates, each search keeps its own progress file and the one passing the most
+// robustness groups at the selection seed is kept (two iterations each: the choice, not the
+// search, is under test).
+TEST(RefinetuneTest, CandidatesSearchOneAfterAnotherAndTheMostGroupsAreKept) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  const TrainOptions options = fast_run_directory(tmp);
+  const std::string policy = (tmp / "run" / "policy.nn").string();
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
+  RunContext ctx = load_run_context(options, ContextUse::kAfterTraining);
+  ctx.rc.finetune.iterations = 2;
+  ctx.rc.finetune.candidates = 2;
+  ctx.run_dir = (tmp / "stage").string();
+  fs::create_directories(ctx.run_dir);
+  std::ostringstream out;
+  const std::string kept = finetune_if_configured(ctx, policy, out, false);
+  EXPECT_EQ(out.str().find("fine-tuning failed"), std::string::npos) << out.str();
+  EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
+  EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune_candidate2.csv"));
+  std::ifstream csv(tmp / "stage" / "candidates.csv");
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(csv, line);) {
+    std::vector<std::string> cells;
+    std::stringstream cells_in(line);
+    for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  ASSERT_EQ(rows.size(), 3u) << out.str();
+  EXPECT_EQ(rows[0][4], "groups_passing");
+  EXPECT_EQ(rows[1][1], std::to_string(ctx.rc.run.seed));
+  EXPECT_EQ(rows[2][1], std::to_string(ctx.rc.run.seed + 1));
+  const int first = std::stoi(rows[1][4]), second = std::stoi(rows[2][4]);
+  const int chosen = second > first ? 2 : 1;
+  EXPECT_EQ(rows[chosen][6], "1");
+  EXPECT_EQ(rows[3 - chosen][6], "0");
+  EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen)), std::string::npos)
+      << out.str();
+  // The chosen search's weights are the ones kept (or the trained policy, where it kept none).
+  EXPECT_TRUE(kept == policy || kept == ctx.run_dir + "/policy_finetuned.nn") << kept;
+  EXPECT_EQ(kept == policy, rows[chosen][2] == "0") << out.str();
 }
 
 using RolesTest = test_support::RolesFixture;

@@ -159,6 +159,18 @@ TEST(TelemetryTest, ObjectiveTermsARowPerControllerEveryPriceInSeconds) {
                std::runtime_error);
 }
 
+TEST(TelemetryTest, CandidatesARowPerSearchTheChosenMarked) {
+  const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
+  write_candidates((dir / "candidates.csv").string(),
+                   {{1, 3, 80, 18.75, 21, 25, false}, {2, 4, 0, 19.5, 25, 25, true}});
+  EXPECT_EQ(slurp(dir / "candidates.csv"),
+            "candidate,seed,kept_iteration,objective_s,groups_passing,groups,chosen\n"
+            "1,3,80,18.75,21,25,0\n"
+            "2,4,0,19.5,25,25,1\n");
+  EXPECT_THROW(write_candidates((dir / "none" / "candidates.csv").string(), {}),
+               std::runtime_error);
+}
+
 TEST(TelemetryTest, AFileThatCannotBeWrittenStopsWithItsPathAndTheReason) {
   const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";

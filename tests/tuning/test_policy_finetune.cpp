@@ -649,7 +649,9 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.integration_substeps = -1; },
         +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
         +[](FinetuneConfig& f) { f.pid_lead_s = std::numeric_limits<double>::infinity(); },
-        +[](FinetuneConfig& f) { f.iterations = -1; }}) {
+        +[](FinetuneConfig& f) { f.iterations = -1; }, +[](FinetuneConfig& f) { f.candidates = 0; },
+        +[](FinetuneConfig& f) { f.candidates = 65; },
+        +[](FinetuneConfig& f) { f.selection_seed = 1; }}) {
     FinetuneConfig f;
     bad(f);
     EXPECT_THROW(f.validate(), std::invalid_argument);
