@@ -40,7 +40,8 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   TrainOptions train;
   train.run_dir = o.run_dir;
   train.source_dir = o.source_dir;
-  train.seed = o.seed;
+  // The run's seed: the one its command line gave, where it gave one, else its configuration's.
+  train.seed = o.seed >= 0 ? o.seed : command_line_seed(o.run_dir).value_or(-1);
   RunContext ctx = load_run_context(train, ContextUse::kAfterTraining);
   if (!o.config_path.empty()) ctx.rc.finetune = read_run_config(o.config_path).finetune;
   if (o.iterations >= 0) ctx.rc.finetune.iterations = o.iterations;

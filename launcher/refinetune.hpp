@@ -19,8 +19,10 @@ struct RefinetuneOptions {
   std::string out_dir;      ///< created (or empty): finetune.csv, policy_finetuned.nn, eval/
   int iterations = -1;      ///< overrides finetune.iterations when >= 0
   int candidates = 0;       ///< overrides finetune.candidates when >= 1
-  std::int64_t seed = -1;   ///< overrides run.seed (the fine-tuning's way-points) when >= 0
-  std::string source_dir;   ///< the source tree (scripts/ for the plots)
+  /// The fine-tuning's seed (its way-points) when >= 0; else the run's: the seed its command
+  /// line gave (command_line.yaml), or its configuration's run.seed.
+  std::int64_t seed = -1;
+  std::string source_dir;  ///< the source tree (scripts/ for the plots)
   /// Also write every validated iterate to out_dir/iterates/ (FinetuneStageInput::keep_iterates).
   bool keep_iterates = false;
 };

@@ -144,6 +144,14 @@ void restore_command_line(TrainOptions& o) {
 
 }  // namespace
 
+std::optional<std::int64_t> command_line_seed(const std::string& run_dir) {
+  TrainOptions saved;
+  saved.run_dir = run_dir;
+  restore_command_line(saved);
+  if (saved.seed < 0) return std::nullopt;
+  return saved.seed;
+}
+
 std::string prepare_run_directory(TrainOptions& o) {
   const std::string config_copy = (fs::path(o.run_dir) / "config.yaml").string();
   if (o.resume) {

@@ -2,6 +2,8 @@
 // logs/, checkpoints/, eval/, plots/, processes/ and the CSV files of the run.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
 
 namespace auvrl::launcher {
@@ -12,6 +14,11 @@ struct TrainOptions;
 /// --resume; returns the path of the run's configuration. Throws std::runtime_error naming
 /// what is wrong.
 std::string prepare_run_directory(TrainOptions& options);
+
+/// The seed `auvrl train`'s command line gave the run in run_dir (its command_line.yaml), if it
+/// gave one: the run's seed where its configuration has another. Throws std::runtime_error
+/// naming the file when it cannot be read.
+std::optional<std::int64_t> command_line_seed(const std::string& run_dir);
 
 /// The path made absolute and normal ("" stays "").
 std::string absolute_path(const std::string& path);

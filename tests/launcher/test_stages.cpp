@@ -66,6 +66,24 @@ TEST(RunDirectoryTest, ANewRunGetsItsFoldersAndAConfigCopyWithAnAbsoluteVehicle)
   EXPECT_THROW(prepare_run_directory(options), std::runtime_error);
 }
 
+TEST(RunDirectoryTest, TheSeedTheCommandLineGaveIsKept) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_rundir_");
+  EXPECT_EQ(command_line_seed(fast_run_directory(tmp).run_dir), std::nullopt);
+  TrainOptions seeded;
+  seeded.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  seeded.run_dir = (tmp / "seeded").string();
+  seeded.seed = 4;
+  prepare_run_directory(seeded);
+  EXPECT_EQ(command_line_seed(seeded.run_dir), std::optional<std::int64_t>(4));
+  std::ofstream(tmp / "seeded" / "command_line.yaml") << "seed: [";
+  try {
+    command_line_seed(seeded.run_dir);
+    FAIL() << "a broken command_line.yaml read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("command_line.yaml"), std::string::npos) << e.what();
+  }
+}
+
 TEST(RunDirectoryTest, OnlyFinishedCheckpointsCount) {
   const fs::path dir = test_support::make_temp_dir("auvrl_ckpt_");
   EXPECT_FALSE(has_checkpoint_file(dir.string()));
@@ -176,25 +194,28 @@ TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
   EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
 }
 
-// With candidates, each search keeps its own progress file and the one passing the most
-// robustness groups at the selection seed is kept (two iterations each: the choice, not the
-// search, is under test).
-TEST(RefinetuneTest, CandidatesSearchOneAfterAnotherAndTheMostGroupsAreKept) {
+// With candidates, each search keeps its own progress file, the seeds follow the run's (the
+// one its command line gave), and the one passing the most robustness groups at the selection
+// seed is kept (two iterations each: the choice, not the search, is under test).
+TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  const TrainOptions options = fast_run_directory(tmp);
+  TrainOptions options;
+  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+  options.run_dir = (tmp / "run").string();
+  options.seed = 4;
+  prepare_run_directory(options);
   const std::string policy = (tmp / "run" / "policy.nn").string();
   fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
-  RunContext ctx = load_run_context(options, ContextUse::kAfterTraining);
-  ctx.rc.finetune.iterations = 2;
-  ctx.rc.finetune.candidates = 2;
-  ctx.run_dir = (tmp / "stage").string();
-  fs::create_directories(ctx.run_dir);
+  RefinetuneOptions o;
+  o.run_dir = options.run_dir;
+  o.out_dir = (tmp / "again").string();
+  o.iterations = 2;
+  o.candidates = 2;
   std::ostringstream out;
-  const std::string kept = finetune_if_configured(ctx, policy, out, false);
-  EXPECT_EQ(out.str().find("fine-tuning failed"), std::string::npos) << out.str();
-  EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
-  EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune_candidate2.csv"));
-  std::ifstream csv(tmp / "stage" / "candidates.csv");
+  ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  EXPECT_TRUE(fs::exists(tmp / "again" / "finetune.csv"));
+  EXPECT_TRUE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
+  std::ifstream csv(tmp / "again" / "candidates.csv");
   std::vector<std::vector<std::string>> rows;
   for (std::string line; std::getline(csv, line);) {
     std::vector<std::string> cells;
@@ -204,17 +225,19 @@ TEST(RefinetuneTest, CandidatesSearchOneAfterAnotherAndTheMostGroupsAreKept) {
   }
   ASSERT_EQ(rows.size(), 3u) << out.str();
   EXPECT_EQ(rows[0][4], "groups_passing");
-  EXPECT_EQ(rows[1][1], std::to_string(ctx.rc.run.seed));
-  EXPECT_EQ(rows[2][1], std::to_string(ctx.rc.run.seed + 1));
-  const int first = std::stoi(rows[1][4]), second = std::stoi(rows[2][4]);
-  const int chosen = second > first ? 2 : 1;
+  EXPECT_EQ(rows[1][1], "4");
+  EXPECT_EQ(rows[2][1], "5");
+  const int chosen = std::stoi(rows[2][4]) > std::stoi(rows[1][4]) ? 2 : 1;
   EXPECT_EQ(rows[chosen][6], "1");
   EXPECT_EQ(rows[3 - chosen][6], "0");
   EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen)), std::string::npos)
       << out.str();
-  // The chosen search's weights are the ones kept (or the trained policy, where it kept none).
-  EXPECT_TRUE(kept == policy || kept == ctx.run_dir + "/policy_finetuned.nn") << kept;
-  EXPECT_EQ(kept == policy, rows[chosen][2] == "0") << out.str();
+  // The chosen search's weights are the ones evaluated (the trained policy where it kept none).
+  std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
+  std::string evaluated;
+  std::getline(selected, evaluated);
+  EXPECT_EQ(evaluated, rows[chosen][2] == "0" ? policy : o.out_dir + "/policy_finetuned.nn")
+      << out.str();
 }
 
 using RolesTest = test_support::RolesFixture;
