@@ -21,7 +21,7 @@ std::uint64_t candidate_seed(std::uint64_t run_seed, int index);
 
 /// Scores policies by the robustness groups they pass against the PID baseline
 /// (eval::compare_robustness with the default bar), on the suite drawn at one seed. The PID's
-/// episodes run once, when it is made.
+/// episodes run once, when it is made. The model must outlive it.
 class SuiteSelector {
  public:
   /// Throws std::invalid_argument when seed is the evaluation's own (eval::EvaluationConfig's
