@@ -329,6 +329,7 @@ int run_finetune_command(int argc, const char* const* argv) {
   cli.option("candidates", &options.candidates,
              "searches, each with its own seed; the one passing the most robustness groups at\n"
              "finetune.selection_seed is kept (default: the config's)");
+  cli.check("candidates", auvrl::cli::at_least(1));
   cli.flag("keep-iterates", &options.keep_iterates,
            "also write the weights validated every 10 iterations (and the last) to\n"
            "OUT/iterates/iteration_NNN.nn (candidate K's to OUT/iterates_candidateK/), to\n"

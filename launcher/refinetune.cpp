@@ -46,6 +46,7 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   if (!o.config_path.empty()) ctx.rc.finetune = read_run_config(o.config_path).finetune;
   if (o.iterations >= 0) ctx.rc.finetune.iterations = o.iterations;
   if (o.candidates >= 1) ctx.rc.finetune.candidates = o.candidates;
+  ctx.rc.finetune.validate();  // the command line's values too, before anything is written
   ctx.run_dir = o.out_dir;
   fs::create_directories(fs::path(o.out_dir) / "processes");
   ctx.config_path = (fs::path(o.out_dir) / "config.yaml").string();

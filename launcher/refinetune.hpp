@@ -30,7 +30,9 @@ struct RefinetuneOptions {
 /// Fine-tunes and evaluates as `auvrl train`'s stages do; the output directory gets the run's
 /// configuration (config.yaml) and the one whose finetune: section was used
 /// (finetune_config.yaml, when another). Returns 0, or 1 when the policy cannot be read. Throws
-/// std::invalid_argument for a missing run, policy or configuration, or a non-empty out_dir.
+/// std::invalid_argument for a missing run, policy or configuration, a non-empty out_dir, or
+/// fine-tuning settings out of range (those of --config or of the options above), before it
+/// writes anything.
 int refinetune(const RefinetuneOptions& options, std::ostream& out);
 
 }  // namespace auvrl::launcher

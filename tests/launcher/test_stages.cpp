@@ -232,6 +232,13 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   EXPECT_EQ(rows[3 - chosen][6], "0");
   EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen)), std::string::npos)
       << out.str();
+  // Settings out of range are refused before anything is written.
+  RefinetuneOptions too_many = o;
+  too_many.out_dir = (tmp / "too_many").string();
+  too_many.candidates = 65;
+  std::ostringstream refused;
+  EXPECT_THROW(refinetune(too_many, refused), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(too_many.out_dir));
   // The chosen search's weights are the ones evaluated (the trained policy where it kept none).
   std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
   std::string evaluated;
