@@ -20,6 +20,7 @@
 #include "launcher/run_directory.hpp"
 #include "launcher/training.hpp"
 #include "roles_fixture.hpp"
+#include "run_files.hpp"
 
 namespace auvrl::launcher {
 namespace {
@@ -30,11 +31,14 @@ bool has(const std::vector<std::string>& argv, const std::vector<std::string>& r
   return std::search(argv.begin(), argv.end(), run.begin(), run.end()) != argv.end();
 }
 
-/// A new run directory tmp/run for the fast preset, as `auvrl train` prepares it.
-TrainOptions fast_run_directory(const fs::path& tmp) {
+/// A new run directory tmp/name for the fast preset, as `auvrl train` prepares it; a seed >= 0
+/// as if the command line gave it (command_line.yaml).
+TrainOptions fast_run_directory(const fs::path& tmp, const std::string& name = "run",
+                                std::int64_t seed = -1) {
   TrainOptions options;
   options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  options.run_dir = (tmp / "run").string();
+  options.run_dir = (tmp / name).string();
+  options.seed = seed;
   prepare_run_directory(options);
   return options;
 }
@@ -69,11 +73,7 @@ TEST(RunDirectoryTest, ANewRunGetsItsFoldersAndAConfigCopyWithAnAbsoluteVehicle)
 TEST(RunDirectoryTest, TheSeedTheCommandLineGaveIsKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_rundir_");
   EXPECT_EQ(command_line_seed(fast_run_directory(tmp).run_dir), std::nullopt);
-  TrainOptions seeded;
-  seeded.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  seeded.run_dir = (tmp / "seeded").string();
-  seeded.seed = 4;
-  prepare_run_directory(seeded);
+  const TrainOptions seeded = fast_run_directory(tmp, "seeded", 4);
   EXPECT_EQ(command_line_seed(seeded.run_dir), std::optional<std::int64_t>(4));
   std::ofstream(tmp / "seeded" / "command_line.yaml") << "seed: [";
   try {
@@ -199,11 +199,7 @@ TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
 // seed is kept (two iterations each: the choice, not the search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  TrainOptions options;
-  options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
-  options.run_dir = (tmp / "run").string();
-  options.seed = 4;
-  prepare_run_directory(options);
+  const TrainOptions options = fast_run_directory(tmp, "run", 4);
   const std::string policy = (tmp / "run" / "policy.nn").string();
   fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
   RefinetuneOptions o;
@@ -215,22 +211,16 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
   EXPECT_TRUE(fs::exists(tmp / "again" / "finetune.csv"));
   EXPECT_TRUE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
-  std::ifstream csv(tmp / "again" / "candidates.csv");
-  std::vector<std::vector<std::string>> rows;
-  for (std::string line; std::getline(csv, line);) {
-    std::vector<std::string> cells;
-    std::stringstream cells_in(line);
-    for (std::string cell; std::getline(cells_in, cell, ',');) cells.push_back(cell);
-    rows.push_back(cells);
-  }
-  ASSERT_EQ(rows.size(), 3u) << out.str();
-  EXPECT_EQ(rows[0][4], "groups_passing");
-  EXPECT_EQ(rows[1][1], "4");
-  EXPECT_EQ(rows[2][1], "5");
-  const int chosen = std::stoi(rows[2][4]) > std::stoi(rows[1][4]) ? 2 : 1;
-  EXPECT_EQ(rows[chosen][6], "1");
-  EXPECT_EQ(rows[3 - chosen][6], "0");
-  EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen)), std::string::npos)
+  const auto rows = test_support::read_csv(tmp / "again" / "candidates.csv");
+  ASSERT_EQ(rows.size(), 2u) << out.str();
+  ASSERT_EQ(rows[0].count("groups_passing"), 1u);
+  EXPECT_EQ(rows[0].at("seed"), "4");
+  EXPECT_EQ(rows[1].at("seed"), "5");
+  const std::size_t chosen =
+      std::stoi(rows[1].at("groups_passing")) > std::stoi(rows[0].at("groups_passing")) ? 1 : 0;
+  EXPECT_EQ(rows[chosen].at("chosen"), "1");
+  EXPECT_EQ(rows[1 - chosen].at("chosen"), "0");
+  EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen + 1)), std::string::npos)
       << out.str();
   // Settings out of range are refused before anything is written.
   RefinetuneOptions too_many = o;
@@ -243,7 +233,8 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
   std::string evaluated;
   std::getline(selected, evaluated);
-  EXPECT_EQ(evaluated, rows[chosen][2] == "0" ? policy : o.out_dir + "/policy_finetuned.nn")
+  EXPECT_EQ(evaluated,
+            rows[chosen].at("kept_iteration") == "0" ? policy : o.out_dir + "/policy_finetuned.nn")
       << out.str();
 }
 

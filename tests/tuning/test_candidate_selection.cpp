@@ -7,27 +7,15 @@
 #include <vector>
 
 #include "agent_test_util.hpp"
-#include "common/nn/file_io.hpp"
-#include "common/nn/serialize.hpp"
 #include "tuning/candidate_selection.hpp"
+#include "tuning_test_util.hpp"
 
 namespace auvrl::tuning {
 namespace {
 
+using test::committed_policy;
+using test::fast_task;
 using test_support::nessie;
-
-task::TaskConfig fast_task() {
-  task::TaskConfig t;
-  t.layout = task::StateLayout::kExtendedThrust;
-  t.num_thrusters = 6;
-  t.max_thrust_n = nessie().thruster_dynamics.max_thrust_n;
-  return t;
-}
-
-nn::Mlp committed_policy() {
-  return nn::network_from_bytes(nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"),
-                                1);
-}
 
 TEST(CandidateSelection, TheFirstCandidateIsTheRunsOwnSeed) {
   EXPECT_EQ(candidate_seed(7, 0), 7u);
