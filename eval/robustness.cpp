@@ -658,6 +658,47 @@ std::string write_robustness_comparison(const std::string& path,
   return table;
 }
 
+void write_robustness_comparison_csv(const std::string& path,
+                                     const std::vector<GroupComparison>& comparisons) {
+  // The columns as docs/usage.md lists them.
+  static const std::vector<std::string> columns = {"group",
+                                                   "passes",
+                                                   "held",
+                                                   "no_flip",
+                                                   "time",
+                                                   "energy",
+                                                   "hold",
+                                                   "smoothness",
+                                                   "episodes",
+                                                   "held_policy",
+                                                   "held_pid",
+                                                   "flips_policy",
+                                                   "flips_pid",
+                                                   "time_to_reach_policy_s",
+                                                   "time_to_reach_pid_s",
+                                                   "thrust_energy_policy",
+                                                   "thrust_energy_pid",
+                                                   "hold_error_policy_m",
+                                                   "hold_error_pid_m",
+                                                   "smoothness_policy",
+                                                   "smoothness_pid"};
+  csv::Writer out(path, columns, csv::Mode::kTruncate, kCsvDigits);
+  for (const GroupComparison& c : comparisons) {
+    out.cell(c.policy.group).cell(c.passes()).cell(c.held).cell(c.no_flip).cell(c.time);
+    out.cell(c.energy).cell(c.hold).cell(c.smoothness);
+    out.cell(c.policy.episodes).cell(c.policy.held).cell(c.reference.held);
+    out.cell(c.policy.flips).cell(c.reference.flips);
+    cell_or_empty(out, c.policy.mean_time_s);
+    cell_or_empty(out, c.reference.mean_time_s);
+    out.cell(c.policy.mean_energy).cell(c.reference.mean_energy);
+    cell_or_empty(out, c.policy.mean_hold_m);
+    cell_or_empty(out, c.reference.mean_hold_m);
+    out.cell(c.policy.mean_smoothness).cell(c.reference.mean_smoothness);
+    out.end_row();
+  }
+  out.flush();
+}
+
 std::string format_robustness_table(const std::vector<GroupMetrics>& groups) {
   std::string out = fmt::format("{:<17}{:<11}{:>8}{:>8}{:>7}{:>9}{:>10}{:>10}{:>9}{:>8}\n", "group",
                                 "controller", "reached", "held", "flips", "blow-ups", "time [s]",
@@ -717,13 +758,16 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
     std::unique_ptr<agent::Controller> pid = make_eval_controller(pid_request, model, pid_config);
     const RobustnessResult reference =
         run(*pid, pid_config, (std::filesystem::path(request.out_dir) / "pid").string());
-    const std::string path =
-        (std::filesystem::path(request.out_dir) / "robustness_comparison.md").string();
+    const std::filesystem::path dir(request.out_dir);
+    const std::vector<GroupComparison> comparisons =
+        compare_robustness(result.groups, reference.groups);
     out << "\n"
         << write_robustness_comparison(
-               path, compare_robustness(result.groups, reference.groups),
-               paired_margins(result.rows, reference.rows, request.seed, config.reach_radius_m))
-        << "wrote " << path << "\n";
+               (dir / "robustness_comparison.md").string(), comparisons,
+               paired_margins(result.rows, reference.rows, request.seed, config.reach_radius_m));
+    write_robustness_comparison_csv((dir / "robustness_comparison.csv").string(), comparisons);
+    out << "wrote " << (dir / "robustness_comparison.md").string() << " and "
+        << (dir / "robustness_comparison.csv").string() << "\n";
   }
   return result;
 }

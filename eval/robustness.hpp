@@ -231,6 +231,13 @@ std::string write_robustness_comparison(const std::string& path,
                                         const std::vector<GroupComparison>& comparisons,
                                         const std::vector<GroupMargins>& margins = {});
 
+/// Writes the comparison as CSV, one row per group: whether it passes, each criterion's pass
+/// (1) or fail (0), then the policy's and the PID's figures (columns in docs/usage.md; a mean
+/// over no reached episode is empty). The same comparison as the Markdown table, for scripts
+/// that read many runs. Throws std::runtime_error naming the path when it cannot write.
+void write_robustness_comparison_csv(const std::string& path,
+                                     const std::vector<GroupComparison>& comparisons);
+
 /// What run_robustness did.
 struct RobustnessResult {
   std::vector<EvaluationEpisode> episodes;

@@ -76,7 +76,7 @@ int run_eval(int argc, const char* const* argv) {
              "episodes per group of the robustness suite");
   cli.flag("with-pid", &request.robustness_with_pid,
            "robustness: also run the PID on the same episodes (DIR/pid/) and write "
-           "DIR/robustness_comparison.md");
+           "DIR/robustness_comparison.md and .csv");
   if (!cli.parse(argc, argv)) return 0;
   request.seed = static_cast<std::uint64_t>(seed);
   if (!request.mission_path.empty()) {

@@ -296,6 +296,8 @@ EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy
     eval::write_robustness_comparison(
         (eval_dir / "robustness_comparison.md").string(), result.robustness,
         eval::paired_margins(p.rows, r.rows, config.seed, config.reach_radius_m));
+    eval::write_robustness_comparison_csv((eval_dir / "robustness_comparison.csv").string(),
+                                          result.robustness);
     out << fmt::format(
         "auvrl train: robustness suite: {} episodes each, policy {:.1f} s, PID {:.1f} s\n",
         p.rows.size(), p.elapsed_s, r.elapsed_s);

@@ -307,17 +307,24 @@ GroupMetrics metrics(const std::string& group, int held, double time_s, double h
   return m;
 }
 
+/// The PID's three groups of the comparison tests.
+std::vector<GroupMetrics> example_pid_groups() {
+  const double none = std::nan("");
+  return {metrics("ok", 18, 10, 0.05, 60, 0.01), metrics("bad", 20, 10, 0.05, 60, 0.01),
+          metrics("lost", 0, none, none, 60, 0.01)};
+}
+
+/// The policy's: "ok": as often, sooner, less energy, hold within 0.05 m, smoothness at 2x:
+/// passes. "bad": fails every criterion. "lost": the PID reached nothing, the policy did.
+std::vector<GroupMetrics> example_policy_groups() {
+  return {metrics("ok", 18, 9.9, 0.1, 60, 0.02), metrics("bad", 19, 10.1, 0.11, 61, 0.021, 1),
+          metrics("lost", 3, 30, 0.4, 50, 0.01)};
+}
+
 TEST(RobustnessComparison, EachCriterionOfTheBar) {
   const double none = std::nan("");
-  const std::vector<GroupMetrics> pid = {metrics("ok", 18, 10, 0.05, 60, 0.01),
-                                         metrics("bad", 20, 10, 0.05, 60, 0.01),
-                                         metrics("lost", 0, none, none, 60, 0.01)};
-  // "ok": as often, sooner, less energy, hold within 0.05 m, smoothness at 2x: passes. "bad":
-  // fails every criterion. "lost": the PID reached nothing, the policy did.
-  const std::vector<GroupMetrics> policy = {metrics("ok", 18, 9.9, 0.1, 60, 0.02),
-                                            metrics("bad", 19, 10.1, 0.11, 61, 0.021, 1),
-                                            metrics("lost", 3, 30, 0.4, 50, 0.01)};
-  const std::vector<GroupComparison> c = compare_robustness(policy, pid);
+  const std::vector<GroupMetrics> pid = example_pid_groups();
+  const std::vector<GroupComparison> c = compare_robustness(example_policy_groups(), pid);
   ASSERT_EQ(c.size(), 3u);
   EXPECT_TRUE(c[0].passes());
   EXPECT_FALSE(c[1].held);
@@ -343,6 +350,48 @@ TEST(RobustnessComparison, EachCriterionOfTheBar) {
       << table;
   EXPECT_NE(table.find("30.0 vs - pass"), std::string::npos) << table;
   EXPECT_NE(table.find("2 of 3 groups pass every criterion"), std::string::npos) << table;
+}
+
+TEST(RobustnessComparison, TheCsvHasEachCriterionAndBothControllersFigures) {
+  TempDir dir;
+  const std::string path = dir.path("comparison.csv");
+  write_robustness_comparison_csv(
+      path, compare_robustness(example_policy_groups(), example_pid_groups()));
+  const std::vector<std::vector<std::string>> rows = read_csv(path);
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(rows[0], (std::vector<std::string>{"group",
+                                               "passes",
+                                               "held",
+                                               "no_flip",
+                                               "time",
+                                               "energy",
+                                               "hold",
+                                               "smoothness",
+                                               "episodes",
+                                               "held_policy",
+                                               "held_pid",
+                                               "flips_policy",
+                                               "flips_pid",
+                                               "time_to_reach_policy_s",
+                                               "time_to_reach_pid_s",
+                                               "thrust_energy_policy",
+                                               "thrust_energy_pid",
+                                               "hold_error_policy_m",
+                                               "hold_error_pid_m",
+                                               "smoothness_policy",
+                                               "smoothness_pid"}));
+  EXPECT_EQ(rows[1], (std::vector<std::string>{"ok", "1",  "1",  "1",   "1",    "1",    "1",
+                                               "1",  "20", "18", "18",  "0",    "0",    "9.9",
+                                               "10", "60", "60", "0.1", "0.05", "0.02", "0.01"}));
+  EXPECT_EQ(rows[2], (std::vector<std::string>{
+                         "bad", "0", "0",    "0",  "0",  "0",  "0",    "0",    "20",    "19",  "20",
+                         "1",   "0", "10.1", "10", "61", "60", "0.11", "0.05", "0.021", "0.01"}));
+  // The PID reached nothing: its means are empty, and the policy passes.
+  EXPECT_EQ(rows[3], (std::vector<std::string>{"lost", "1",  "1",  "1",   "1", "1",    "1",
+                                               "1",    "20", "3",  "0",   "0", "0",    "30",
+                                               "",     "50", "60", "0.4", "",  "0.01", "0.01"}));
+  EXPECT_THROW(write_robustness_comparison_csv(dir.path("missing/comparison.csv"), {}),
+               std::runtime_error);
 }
 
 TEST(RobustnessMargins, BootstrapIntervalOfTheMean) {
@@ -521,11 +570,20 @@ TEST(RobustnessCommand, ComparesAPolicyWithThePid) {
   const RobustnessResult result = run_robustness_request(request, out);
   EXPECT_EQ(result.rows.size(), 25u);
   EXPECT_EQ(result.rows[0].controller, "policy");
-  for (const char* file : {"run/robustness.csv", "run/robustness_episodes.csv",
-                           "run/pid/robustness.csv", "run/robustness_comparison.md"}) {
+  for (const char* file :
+       {"run/robustness.csv", "run/robustness_episodes.csv", "run/pid/robustness.csv",
+        "run/robustness_comparison.md", "run/robustness_comparison.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(dir.path(file))) << file;
   }
-  EXPECT_NE(out.str().find("groups pass every criterion"), std::string::npos) << out.str();
+  // The CSV says what the table says: as many groups passing.
+  const std::vector<std::vector<std::string>> csv_rows =
+      read_csv(dir.path("run/robustness_comparison.csv"));
+  ASSERT_EQ(csv_rows.size(), 26u);
+  int passing = 0;
+  for (std::size_t i = 1; i < csv_rows.size(); ++i) passing += csv_rows[i][1] == "1" ? 1 : 0;
+  EXPECT_NE(out.str().find(std::to_string(passing) + " of 25 groups pass every criterion"),
+            std::string::npos)
+      << out.str();
   // Then how sure each criterion is, episode by episode.
   EXPECT_NE(out.str().find("| rest_start | "), out.str().rfind("| rest_start | ")) << out.str();
   EXPECT_NE(out.str().find("How sure each criterion is"), std::string::npos) << out.str();

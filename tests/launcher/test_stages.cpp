@@ -113,7 +113,8 @@ TEST(EvaluateStageTest, ThePolicyAndThePidOnTheScenariosAndTheRobustnessSuite) {
   EXPECT_GT(result.robustness_pid_s, 0.0);
   for (const char* file : {"eval/policy/summary.csv", "eval/policy/robustness.csv",
                            "eval/policy/robustness_episodes.csv", "eval/pid/robustness.csv",
-                           "eval/pid/robustness_episodes.csv", "eval/robustness_comparison.md"}) {
+                           "eval/pid/robustness_episodes.csv", "eval/robustness_comparison.md",
+                           "eval/robustness_comparison.csv"}) {
     EXPECT_TRUE(fs::exists(tmp / "run" / file)) << file;
   }
   // The comparison, then the margins with their intervals.
