@@ -14,6 +14,7 @@ Usage: scripts/robustness_census.py COMPARISON [COMPARISON ...] [--out CSV]
 import argparse
 import csv
 import os
+import signal
 import sys
 
 CRITERIA = ('held', 'no_flip', 'time', 'energy', 'hold', 'smoothness')
@@ -66,6 +67,8 @@ def census(comparisons):
 
 
 def main():
+    # Piped into head or less, end quietly when the reader stops.
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('comparisons', nargs='+', help='robustness_comparison.csv or its folder')
     parser.add_argument('--out', help='also write the census as CSV here')
