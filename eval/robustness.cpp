@@ -646,18 +646,6 @@ void write_robustness_csv(const std::string& path, const std::vector<GroupMetric
   out.flush();
 }
 
-std::string write_robustness_comparison(const std::string& path,
-                                        const std::vector<GroupComparison>& comparisons,
-                                        const std::vector<GroupMargins>& margins) {
-  std::string table = robustness_comparison_markdown(comparisons);
-  if (!margins.empty()) table += "\n" + robustness_margins_markdown(margins);
-  std::ofstream file(path);
-  file << table;
-  file.flush();
-  if (!file) throw std::runtime_error(path + ": cannot write");
-  return table;
-}
-
 void write_robustness_comparison_csv(const std::string& path,
                                      const std::vector<GroupComparison>& comparisons) {
   // The columns as docs/usage.md lists them.
@@ -697,6 +685,21 @@ void write_robustness_comparison_csv(const std::string& path,
     out.end_row();
   }
   out.flush();
+}
+
+std::string write_robustness_comparison(const std::string& dir,
+                                        const std::vector<GroupComparison>& comparisons,
+                                        const std::vector<GroupMargins>& margins) {
+  std::string table = robustness_comparison_markdown(comparisons);
+  if (!margins.empty()) table += "\n" + robustness_margins_markdown(margins);
+  const std::string path = (std::filesystem::path(dir) / "robustness_comparison.md").string();
+  std::ofstream file(path);
+  file << table;
+  file.flush();
+  if (!file) throw std::runtime_error(path + ": cannot write");
+  write_robustness_comparison_csv(
+      (std::filesystem::path(dir) / "robustness_comparison.csv").string(), comparisons);
+  return table;
 }
 
 std::string format_robustness_table(const std::vector<GroupMetrics>& groups) {
@@ -759,14 +762,11 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
     const RobustnessResult reference =
         run(*pid, pid_config, (std::filesystem::path(request.out_dir) / "pid").string());
     const std::filesystem::path dir(request.out_dir);
-    const std::vector<GroupComparison> comparisons =
-        compare_robustness(result.groups, reference.groups);
     out << "\n"
         << write_robustness_comparison(
-               (dir / "robustness_comparison.md").string(), comparisons,
-               paired_margins(result.rows, reference.rows, request.seed, config.reach_radius_m));
-    write_robustness_comparison_csv((dir / "robustness_comparison.csv").string(), comparisons);
-    out << "wrote " << (dir / "robustness_comparison.md").string() << " and "
+               request.out_dir, compare_robustness(result.groups, reference.groups),
+               paired_margins(result.rows, reference.rows, request.seed, config.reach_radius_m))
+        << "wrote " << (dir / "robustness_comparison.md").string() << " and "
         << (dir / "robustness_comparison.csv").string() << "\n";
   }
   return result;

@@ -224,10 +224,11 @@ std::string robustness_margins_markdown(const std::vector<GroupMargins>& margins
 std::string robustness_comparison_markdown(const std::vector<GroupComparison>& comparisons,
                                            const RobustnessBar& bar = {});
 
-/// Writes the Markdown table (robustness_comparison_markdown, the default bar), then the
-/// margins' table when there are margins, to path and returns what it wrote; throws
-/// std::runtime_error naming the path when it cannot.
-std::string write_robustness_comparison(const std::string& path,
+/// Writes dir/robustness_comparison.md (the Markdown table, robustness_comparison_markdown with
+/// the default bar, then the margins' table when there are margins) and
+/// dir/robustness_comparison.csv (write_robustness_comparison_csv), and returns the Markdown;
+/// throws std::runtime_error naming the path it cannot write.
+std::string write_robustness_comparison(const std::string& dir,
                                         const std::vector<GroupComparison>& comparisons,
                                         const std::vector<GroupMargins>& margins = {});
 

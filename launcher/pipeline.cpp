@@ -294,10 +294,8 @@ EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy
     result.robustness_policy_s = p.elapsed_s;
     result.robustness_pid_s = r.elapsed_s;
     eval::write_robustness_comparison(
-        (eval_dir / "robustness_comparison.md").string(), result.robustness,
+        eval_dir.string(), result.robustness,
         eval::paired_margins(p.rows, r.rows, config.seed, config.reach_radius_m));
-    eval::write_robustness_comparison_csv((eval_dir / "robustness_comparison.csv").string(),
-                                          result.robustness);
     out << fmt::format(
         "auvrl train: robustness suite: {} episodes each, policy {:.1f} s, PID {:.1f} s\n",
         p.rows.size(), p.elapsed_s, r.elapsed_s);
