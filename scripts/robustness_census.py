@@ -73,7 +73,13 @@ def main():
     parser.add_argument('comparisons', nargs='+', help='robustness_comparison.csv or its folder')
     parser.add_argument('--out', help='also write the census as CSV here')
     args = parser.parse_args()
-    comparisons = [read_comparison(comparison_path(a)) for a in args.comparisons]
+    paths = [comparison_path(a) for a in args.comparisons]
+    comparisons = [read_comparison(p) for p in paths]
+    # The mean "of N" is one suite's: comparisons of different suites would mix their counts.
+    for path, groups in zip(paths, comparisons):
+        if sorted(g for g, _, _ in groups) != sorted(g for g, _, _ in comparisons[0]):
+            sys.exit(f'robustness_census.py: {path}: its groups differ from those of {paths[0]} '
+                     f'(another vehicle or suite?); count each suite apart')
     table = census(comparisons)
     passing = [sum(1 for _, passes, _ in groups if passes) for groups in comparisons]
     print(f'{len(comparisons)} comparisons; groups passing: mean {sum(passing) / len(passing):.2f} '

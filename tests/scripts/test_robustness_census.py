@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """scripts/robustness_census.py on fabricated comparison files: the groups passing and the
 failures per group and criterion add up as written, a file, its folder and a run directory are
-read alike, and a missing file, a missing column and a bad cell are named.
+read alike, and a missing file, a missing column, a bad cell and another suite's groups are named.
 
 Usage: test_robustness_census.py SCRIPT
 """
@@ -79,6 +79,12 @@ with tempfile.TemporaryDirectory() as tmp:
     done = run(bad_cell)
     check(done.returncode != 0 and "line 3: column held: expected 0 or 1, found 'yes'"
           in done.stderr, f'bad cell: {done.returncode} {done.stderr}')
+
+    other_suite = os.path.join(tmp, 'other_suite.csv')
+    write(other_suite, [row('rest_start'), row('t6_0pct')])
+    done = run(a, other_suite)
+    check(done.returncode != 0 and 'other_suite.csv: its groups differ' in done.stderr,
+          f'another suite: {done.returncode} {done.stderr}')
 
 for f in failures:
     print('FAIL:', f)
