@@ -35,21 +35,33 @@ void PolicyController::set_network(nn::Mlp network) {
 }
 
 void PolicyController::use_integral_action(const task::TaskConfig& task) {
-  integral_task_.reset();
-  if (task.integral.enabled()) integral_task_ = task;
+  driving_task_.reset();
+  position_filter_.reset();
+  if (task.position_filter.enabled()) {
+    position_filter_.emplace(task.position_filter, task.control_step_s);
+  }
+  if (task.integral.enabled() || position_filter_) driving_task_ = task;
   goal_offset_ned_m_.setZero();
 }
 
 void PolicyController::act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
                            const task::StateVector& state, task::ActionVector& action) {
-  if (!integral_task_) {
+  if (!driving_task_) {
     action = network_.forward(state);
     return;
   }
-  const Eigen::Vector3d moved_goal_ned_m = task::advance_goal_integral(
-      *integral_task_, goal_ned_m, observation.position_ned_m, goal_offset_ned_m_);
+  const task::TaskConfig& task = *driving_task_;
+  const Eigen::Vector3d position_ned_m =
+      position_filter_ ? position_filter_->update(observation) : observation.position_ned_m;
+  const Eigen::Vector3d shown_goal_ned_m =
+      task.integral.enabled()
+          ? task::advance_goal_integral(task, goal_ned_m, position_ned_m, goal_offset_ned_m_)
+          : goal_ned_m;
   moved_state_ = state;
-  task::relabel_state(*integral_task_, goal_ned_m, moved_goal_ned_m, moved_state_);
+  task::relabel_state(task, goal_ned_m, shown_goal_ned_m, moved_state_);
+  if (position_filter_) {
+    task::shift_position(task, position_ned_m - observation.position_ned_m, moved_state_);
+  }
   action = network_.forward(moved_state_);
 }
 

@@ -24,20 +24,26 @@ class Controller {
   virtual std::string name() const = 0;
 };
 
-/// The learned policy mu(x | theta): the actor network on the task's observation vector. With
-/// integral action on (use_integral_action), it is shown the goal moved by the task's goal
-/// integrator (task::GoalIntegralSettings) instead of the goal itself.
+/// The learned policy mu(x | theta): the actor network on the task's observation vector. When
+/// it drives (use_integral_action), it is shown the goal moved by the task's goal integrator
+/// (task::GoalIntegralSettings) instead of the goal itself, and the position estimated by the
+/// task's position filter (task::PositionFilterSettings) instead of the measured one.
 class PolicyController final : public Controller {
  public:
   /// Throws std::invalid_argument if the network's input/output sizes do not match.
   PolicyController(nn::Mlp network, int state_dim, int num_thrusters);
-  /// A policy that drives: sizes from the task, integral action as task.integral says.
+  /// A policy that drives: sizes from the task, integral action and position filter as
+  /// task.integral and task.position_filter say.
   PolicyController(nn::Mlp network, const task::TaskConfig& task);
-  /// Integral action as task.integral says (off when its gain is 0). The actors' exploring
-  /// policy never uses it; a policy that drives does.
+  /// Integral action as task.integral says (off when its gain is 0) and the position filter as
+  /// task.position_filter says (off when its time constant is 0). The actors' exploring policy
+  /// never uses them; a policy that drives does.
   void use_integral_action(const task::TaskConfig& task);
-  /// Clears the integrator (the start of an episode or mission).
-  void reset() override { goal_offset_ned_m_.setZero(); }
+  /// Clears the integrator and the position filter (the start of an episode or mission).
+  void reset() override {
+    goal_offset_ned_m_.setZero();
+    if (position_filter_) position_filter_->reset();
+  }
   void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
            const task::StateVector& state, task::ActionVector& action) override;
   /// The integrator's goal offset now, NED, m.
@@ -51,7 +57,8 @@ class PolicyController final : public Controller {
   nn::Mlp network_;
   int state_dim_;
   int num_thrusters_;
-  std::optional<task::TaskConfig> integral_task_;  ///< set when integral action is on
+  std::optional<task::TaskConfig> driving_task_;  ///< set when integral action or filter is on
+  std::optional<task::PositionFilter> position_filter_;
   Eigen::Vector3d goal_offset_ned_m_ = Eigen::Vector3d::Zero();
   task::StateVector moved_state_;
 };

@@ -102,6 +102,12 @@ void TaskConfig::validate() const {
                                             GoalIntegralSettings::kMaxGainPerS));
   }
   positive(integral.radius_m, "integral.radius_m");
+  if (!(position_filter.time_constant_s >= 0 &&
+        position_filter.time_constant_s <= PositionFilterSettings::kMaxTimeConstantS)) {
+    throw std::invalid_argument(
+        fmt::format("task.position_filter.time_constant_s must be in [0, {}] (s), got {}",
+                    PositionFilterSettings::kMaxTimeConstantS, position_filter.time_constant_s));
+  }
   if (!(integral.max_offset_m >= 0) || !std::isfinite(integral.max_offset_m)) {
     throw std::invalid_argument("task.integral.max_offset_m must be finite and >= 0");
   }
@@ -197,6 +203,41 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
   error_body += r.transpose() * shift;
   state.segment<3>(kExtError) = (error_body / c.scales.position_m).cast<float>();
   state[kExtDistance] = static_cast<float>(error_body.norm() / c.scales.position_m);
+}
+
+void shift_position(const TaskConfig& c, const Eigen::Vector3d& shift_ned_m,
+                    Eigen::Ref<StateVector> state) {
+  // Further along by the shift is the same error as a goal that much nearer.
+  relabel_state(c, shift_ned_m, Eigen::Vector3d::Zero(), state);
+  if (c.layout == StateLayout::kPaper) {
+    state.segment<3>(kPaperPosition) += (shift_ned_m / c.scales.position_m).cast<float>();
+  } else {
+    state[kExtAction + c.num_thrusters] += static_cast<float>(shift_ned_m.z() / c.scales.depth_m);
+  }
+}
+
+PositionFilter::PositionFilter(const PositionFilterSettings& settings, double control_step_s)
+    : control_step_s_(control_step_s),
+      gain_(-std::expm1(-control_step_s / settings.time_constant_s)) {
+  if (!settings.enabled() || !(control_step_s > 0.0)) {
+    throw std::invalid_argument(fmt::format(
+        "PositionFilter: needs time_constant_s > 0 (got {}) and a positive control step (got {})",
+        settings.time_constant_s, control_step_s));
+  }
+}
+
+const Eigen::Vector3d& PositionFilter::update(const Observation& measured) {
+  const Eigen::Vector3d velocity_ned_mps =
+      body_to_ned(measured.euler_rpy_rad) * measured.velocity_body_mps;
+  if (!started_) {
+    position_ned_m_ = measured.position_ned_m;
+    started_ = true;
+  } else {
+    position_ned_m_ += 0.5 * control_step_s_ * (velocity_ned_mps + velocity_ned_mps_);
+    position_ned_m_ += gain_ * (measured.position_ned_m - position_ned_m_);
+  }
+  velocity_ned_mps_ = velocity_ned_mps;
+  return position_ned_m_;
 }
 
 Eigen::Vector3d advance_goal_integral(const TaskConfig& c, const Eigen::Vector3d& goal_ned_m,

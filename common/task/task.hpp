@@ -85,6 +85,18 @@ struct GoalIntegralSettings {
   bool enabled() const { return gain_per_s > 0.0; }
 };
 
+/// The position a driving policy is shown (evaluation, fine-tuning, missions, deployment; never
+/// the actors' training episodes): a complementary filter (task::PositionFilter) that
+/// dead-reckons from the measured velocity and attitude and pulls the estimate toward each
+/// position fix with this time constant. White position noise reaches the policy several times
+/// weaker; noise-free, the estimate follows the vehicle.
+struct PositionFilterSettings {
+  /// The longest time constant accepted, s (the estimate then rides on the velocity alone).
+  static constexpr double kMaxTimeConstantS = 10.0;
+  double time_constant_s = 0.5;  ///< s, 0: off (the measured position itself)
+  bool enabled() const { return time_constant_s > 0.0; }
+};
+
 /// Every constant of the task. Defaults are the paper's where it gives one.
 struct TaskConfig {
   StateLayout layout = StateLayout::kPaper;
@@ -149,6 +161,8 @@ struct TaskConfig {
 
   /// The driving policy's integral action (not the paper's: its preset turns it off).
   GoalIntegralSettings integral;
+  /// The driving policy's position estimate (not the paper's: its preset turns it off).
+  PositionFilterSettings position_filter;
 
   /// Size of the observation vector.
   int state_dim() const;
@@ -200,6 +214,33 @@ Eigen::Vector3d advance_goal_integral(const TaskConfig& config, const Eigen::Vec
 /// goal-dependent entries change (x_e; or body-frame error and distance).
 void relabel_state(const TaskConfig& config, const Eigen::Vector3d& old_goal_ned_m,
                    const Eigen::Vector3d& new_goal_ned_m, Eigen::Ref<StateVector> state);
+
+/// Rewrites an observation vector for the vehicle shift_ned_m further along than it was built
+/// for: the goal error and distance, and the position (paper layout) or depth entries.
+void shift_position(const TaskConfig& config, const Eigen::Vector3d& shift_ned_m,
+                    Eigen::Ref<StateVector> state);
+
+/// The complementary filter of PositionFilterSettings for one vehicle. Each control step the
+/// estimate moves by the measured velocity rotated into NED by the measured attitude
+/// (trapezoidal, over control_step_s), then by 1 - exp(-step / time_constant_s) of its distance
+/// to the measured position. The first step after reset() takes the measurement as it is.
+class PositionFilter {
+ public:
+  /// Throws std::invalid_argument unless the filter is on and the control step positive.
+  PositionFilter(const PositionFilterSettings& settings, double control_step_s);
+  void reset() { started_ = false; }
+  /// One control step with this measurement; returns the estimate, NED, m.
+  const Eigen::Vector3d& update(const Observation& measured);
+  /// The share of the distance to the measurement closed each step.
+  double gain() const { return gain_; }
+
+ private:
+  double control_step_s_;
+  double gain_;
+  bool started_ = false;
+  Eigen::Vector3d position_ned_m_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_ned_mps_ = Eigen::Vector3d::Zero();  ///< at the last update
+};
 
 /// Vehicle position encoded in an observation vector built for goal_ned_m.
 Eigen::Vector3d position_from_state(const TaskConfig& config, const Eigen::Vector3d& goal_ned_m,

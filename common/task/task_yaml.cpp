@@ -97,6 +97,18 @@ config::Table<GoalIntegralSettings> make_integral_table() {
   return t;
 }
 
+config::Table<PositionFilterSettings> make_position_filter_table() {
+  using F = PositionFilterSettings;
+  config::Table<F> t("position_filter",
+                     "the position a driving policy is shown (evaluation, fine-tuning, missions, "
+                     "deployment; not the actors' training episodes): dead-reckoned from the "
+                     "measured velocity and pulled toward each position fix");
+  t.field("time_constant_s", &F::time_constant_s, "s, 0: off",
+          "how fast the estimate follows the position fixes")
+      .range(0.0, F::kMaxTimeConstantS);
+  return t;
+}
+
 /// The reward's terms.
 void add_reward_fields(config::Table<TaskConfig>& t) {
   using C = TaskConfig;
@@ -144,6 +156,7 @@ void add_episode_fields(config::Table<TaskConfig>& t) {
           "random starts: p, q, r uniform in +- this");
   t.section("randomise", randomise_table(), &C::randomise);
   t.section("integral", make_integral_table(), &C::integral);
+  t.section("position_filter", make_position_filter_table(), &C::position_filter);
 }
 
 config::Table<TaskConfig> make_task_table() {
@@ -188,6 +201,13 @@ void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s) {
   cmd.option("integral-gain", &gain_per_s,
              "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
   cmd.check("integral-gain", CLI::Range(0.0, GoalIntegralSettings::kMaxGainPerS));
+}
+
+void add_position_filter_option(cli::CommandLine& cmd, double& time_constant_s) {
+  cmd.option("position-filter", &time_constant_s,
+             "the policy's position filter, time constant in s (0: off; docs/usage.md, "
+             "\"Position filter\")");
+  cmd.check("position-filter", CLI::Range(0.0, PositionFilterSettings::kMaxTimeConstantS));
 }
 
 void read_task_config(config::Section s, TaskConfig& c) {

@@ -18,6 +18,10 @@ namespace auvrl::task {
 /// (`auvrl eval`, `auvrl export`, `auv_controller`).
 void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s);
 
+/// `--position-filter S` (task.position_filter.time_constant_s, 0: off, checked against
+/// PositionFilterSettings::kMaxTimeConstantS), for the same programs.
+void add_position_filter_option(cli::CommandLine& cmd, double& time_constant_s);
+
 /// Fills `config` from a `task:` section (keys named as the TaskConfig members; absent keys
 /// keep their values) and validates it. Throws config::ConfigError naming file and key.
 void read_task_config(config::Section section, TaskConfig& config);

@@ -3,9 +3,11 @@
 // with other controlled DOF (no pitch, no sway, roll), and its per-vehicle gains files.
 #include <gtest/gtest.h>
 
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <stdexcept>
 
 #include "agent/controller.hpp"
@@ -81,6 +83,7 @@ TEST(PolicyController, SetNetworkChecksSizesAndKeepsTheOldOneOnError) {
 TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
   task::TaskConfig task;
   task.layout = task::StateLayout::kExtended;
+  task.position_filter.time_constant_s = 0.0;  // the next test has it
   task::apply_vehicle(nessie().facts(), task);
   const int dim = task.state_dim();
   PolicyController policy(actor(dim, 6), dim, 6);
@@ -113,6 +116,50 @@ TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
   policy.act(obs, goal, state, action);
   EXPECT_EQ(action, reference.forward(state));
   EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
+}
+
+// With the position filter the network sees the state built where the task's filter puts the
+// vehicle (and, with integral action too, for the goal its integrator moved from there); the
+// first step after reset() is the measured position.
+TEST(PolicyController, ThePositionFilterShowsTheNetworkTheEstimatedPosition) {
+  task::TaskConfig task;
+  task.layout = task::StateLayout::kExtendedThrust;
+  task::apply_vehicle(nessie().facts(), task);
+  ASSERT_TRUE(task.position_filter.enabled());  // on by default
+  const int dim = task.state_dim();
+  const std::vector<double> thrust_n = {5.0, -3.0, 1.0, 0.0, 2.0, -7.0};
+  const task::ActionVector previous = task::ActionVector::Constant(6, -0.1f);
+  const Eigen::Vector3d goal(2.3, 0.6, 6.2);
+  for (double gain_per_s : {0.0, 0.1}) {
+    task.integral.gain_per_s = gain_per_s;
+    PolicyController policy(actor(dim, 6), task);
+    nn::Mlp reference = actor(dim, 6);
+    task::PositionFilter filter(task.position_filter, task.control_step_s);
+    Eigen::Vector3d expected_offset = Eigen::Vector3d::Zero();
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> noise(0.0, 0.1);
+    for (int t = 0; t < 40; ++t) {
+      task::Observation obs;
+      obs.position_ned_m = Eigen::Vector3d(2.0 + noise(rng), 1.0 + noise(rng), 6.0 + noise(rng));
+      obs.euler_rpy_rad = Eigen::Vector3d(0.05, -0.1, 1.2);
+      obs.velocity_body_mps = Eigen::Vector3d(0.02, 0.0, -0.01);
+      task::StateVector state, expected_state;
+      task::build_state(task, obs, goal, previous, state, thrust_n);
+      task::ActionVector action;
+      policy.act(obs, goal, state, action);
+      task::Observation estimated = obs;
+      estimated.position_ned_m = filter.update(obs);
+      if (t == 0) {
+        EXPECT_EQ(estimated.position_ned_m, obs.position_ned_m);
+      }
+      const Eigen::Vector3d shown = task::advance_goal_integral(
+          task, goal, estimated.position_ned_m, expected_offset);
+      task::build_state(task, estimated, shown, previous, expected_state, thrust_n);
+      EXPECT_LE((action - reference.forward(expected_state)).cwiseAbs().maxCoeff(), 1e-5)
+          << "gain " << gain_per_s << " step " << t;
+    }
+    EXPECT_LE((policy.goal_offset_ned_m() - expected_offset).norm(), 1e-12);
+  }
 }
 
 TEST(PidController, PseudoInverseReproducesTheFiveControllableDof) {

@@ -509,6 +509,39 @@ TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
   EXPECT_LT(with_m, 0.6 * without_m);
 }
 
+// The position filter (task.position_filter) is what keeps the committed policy's commands
+// from chasing the sensor noise: with it the commands change less per step and spend less.
+TEST(RobustnessRun, ThePositionFilterCalmsTheCommandsUnderSensorNoise) {
+  EvaluationConfig c = config();
+  task::apply_vehicle(nessie().facts(), c.task);
+  const std::vector<EvaluationEpisode> episodes =
+      of_group(robustness_episodes(c, 6, 4, 1), "sensor_noise");
+  ASSERT_EQ(episodes.size(), 4u);
+  struct Means {
+    double smoothness = 0.0, energy = 0.0;
+  };
+  const auto means = [&](double time_constant_s) {
+    EvaluationConfig with = c;
+    with.task.position_filter.time_constant_s = time_constant_s;
+    auto policy = agent::load_policy(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
+                                     nessie().name, 6, std::nullopt, with.task);
+    Means m;
+    for (const EvaluationEpisode& e : episodes) {
+      const SummaryRow row = run_evaluation_episode(nessie(), with, *policy, e, nullptr);
+      EXPECT_TRUE(row.reached) << e.index;
+      m.smoothness += row.smoothness / static_cast<double>(episodes.size());
+      m.energy += row.thrust_energy / static_cast<double>(episodes.size());
+    }
+    return m;
+  };
+  const Means without = means(0.0), with = means(0.5);
+  std::cout << "under sensor noise: smoothness " << without.smoothness << " without the position "
+            << "filter, " << with.smoothness << " with it; energy " << without.energy << ", "
+            << with.energy << "\n";
+  EXPECT_LT(with.smoothness, 0.8 * without.smoothness);
+  EXPECT_LT(with.energy, 0.9 * without.energy);
+}
+
 TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {
   TempDir dir;
   agent::PidController pid(nessie());

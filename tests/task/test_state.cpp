@@ -294,6 +294,91 @@ TEST(GoalIntegral, UnusableSettingsAreRefusedByName) {
   }
 }
 
+TEST(ShiftPosition, EqualsBuildingTheStateWhereTheVehicleWouldBe) {
+  for (StateLayout layout :
+       {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
+    const TaskConfig c = config(layout);
+    std::mt19937_64 rng(43);
+    std::uniform_real_distribution<double> shift(-0.5, 0.5);
+    for (int i = 0; i < 500; ++i) {
+      Observation obs = random_observation(rng);
+      const Eigen::Vector3d goal(7.0, 6.0, 10.0);
+      const Eigen::Vector3d by(shift(rng), shift(rng), shift(rng));
+      StateVector shifted = build(c, obs, goal, ActionVector::Constant(6, 0.3f));
+      shift_position(c, by, shifted);
+      obs.position_ned_m += by;
+      const StateVector direct = build(c, obs, goal, ActionVector::Constant(6, 0.3f));
+      EXPECT_LT((shifted - direct).cwiseAbs().maxCoeff(), 2e-6f)
+          << to_string(layout) << " sample " << i;
+    }
+  }
+}
+
+/// A vehicle pitched, rolled and yawed, moving at a constant body velocity: its NED velocity is
+/// constant, so its position is a straight line in time.
+Observation steady_motion(double t_s) {
+  Observation o;
+  o.euler_rpy_rad = Eigen::Vector3d(0.1, -0.2, 2.0);
+  o.velocity_body_mps = Eigen::Vector3d(1.2, -0.3, 0.2);
+  o.position_ned_m =
+      Eigen::Vector3d(1.0, -2.0, 5.0) + t_s * body_to_ned(o.euler_rpy_rad) * o.velocity_body_mps;
+  return o;
+}
+
+TEST(PositionFilter, FollowsNoiseFreeMotionAndStartsAtTheMeasurement) {
+  PositionFilterSettings settings;
+  PositionFilter filter(settings, 0.1);
+  EXPECT_NEAR(filter.gain(), 1.0 - std::exp(-0.1 / 0.5), 1e-15);
+  for (int step = 0; step < 300; ++step) {
+    const Observation o = steady_motion(0.1 * step);
+    EXPECT_LT((filter.update(o) - o.position_ned_m).norm(), 1e-12) << step;
+  }
+  // After reset() the first estimate is the measurement itself, wherever the vehicle is.
+  filter.reset();
+  Observation elsewhere = steady_motion(0.0);
+  elsewhere.position_ned_m = Eigen::Vector3d(-4.0, 3.0, 9.0);
+  EXPECT_EQ(filter.update(elsewhere), elsewhere.position_ned_m);
+}
+
+// A vehicle at rest with white position noise: the estimate's spread is the measurement's times
+// sqrt(g / (2 - g)) (a first-order filter with gain g per step): 0.32 of it for 0.5 s at 0.1 s.
+TEST(PositionFilter, CutsWhitePositionNoiseAsAFirstOrderFilterDoes) {
+  PositionFilter filter(PositionFilterSettings{}, 0.1);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  double sum_sq = 0.0;
+  const int steps = 40000;
+  for (int step = 0; step < steps; ++step) {
+    Observation o;
+    o.position_ned_m = Eigen::Vector3d(noise(rng), noise(rng), 5.0 + noise(rng));
+    const Eigen::Vector3d error = filter.update(o) - Eigen::Vector3d(0.0, 0.0, 5.0);
+    if (step >= 100) sum_sq += error.squaredNorm() / 3.0;
+  }
+  const double spread_m = std::sqrt(sum_sq / (steps - 100));
+  const double g = filter.gain();
+  EXPECT_NEAR(spread_m, 0.1 * std::sqrt(g / (2.0 - g)), 0.003);
+  EXPECT_LT(spread_m, 0.035);
+}
+
+TEST(PositionFilter, UnusableSettingsAreRefusedByName) {
+  EXPECT_THROW(PositionFilter(PositionFilterSettings{0.0}, 0.1), std::invalid_argument);
+  EXPECT_THROW(PositionFilter(PositionFilterSettings{0.5}, 0.0), std::invalid_argument);
+  TaskConfig c;
+  for (double bad : {-0.1, PositionFilterSettings::kMaxTimeConstantS + 1.0, std::nan("")}) {
+    c.position_filter.time_constant_s = bad;
+    try {
+      c.validate();
+      ADD_FAILURE() << "time constant " << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("task.position_filter.time_constant_s"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  c.position_filter.time_constant_s = 0.0;
+  EXPECT_NO_THROW(c.validate());
+}
+
 TEST(PositionFromState, RecoversThePositionInEveryLayout) {
   for (StateLayout layout :
        {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {

@@ -327,6 +327,49 @@ TEST(PolicyExportC, IntegratesTheGoalAsAuvrlDoes) {
   EXPECT_LE(max_abs_difference(read_raw<double>(dir.path("moved.f64")), expected), 1e-12);
 }
 
+// The header's position filter estimates the position as the policy controller's does
+// (task::PositionFilter), step by step, on a vehicle that turns, climbs and changes speed under
+// noisy fixes, and takes the fix itself on the first step.
+TEST(PolicyExportC, FiltersThePositionAsAuvrlDoes) {
+  const std::string cc = find_program("cc");
+  if (cc.empty()) GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
+  TempDir dir;
+  const std::string exe = build_driver(dir, kPolicy, cc);
+  ASSERT_FALSE(exe.empty());
+  task::TaskConfig c;
+  task::apply_vehicle(nessie().facts(), c);
+  ASSERT_TRUE(c.position_filter.enabled());
+  task::PositionFilter filter(c.position_filter, c.control_step_s);
+  std::mt19937_64 rng(6);
+  std::normal_distribution<double> noise(0.0, 0.1);
+  std::vector<double> records, expected;
+  for (int t = 0; t < 2000; ++t) {
+    const double time_s = 0.1 * t;
+    task::Observation obs;
+    obs.position_ned_m = Eigen::Vector3d(std::sin(0.05 * time_s) * 20.0 + noise(rng),
+                                         time_s * 0.3 + noise(rng), 5.0 + noise(rng));
+    obs.euler_rpy_rad = Eigen::Vector3d(0.05 * std::sin(time_s), -0.2 + 0.01 * noise(rng),
+                                        std::remainder(0.1 * time_s, 2.0 * 3.14159265358979));
+    obs.velocity_body_mps = Eigen::Vector3d(1.0 + std::cos(0.3 * time_s), 0.2, -0.1 + noise(rng));
+    for (const Eigen::Vector3d* v : {&obs.position_ned_m, &obs.euler_rpy_rad,
+                                     &obs.velocity_body_mps}) {
+      records.insert(records.end(), v->data(), v->data() + 3);
+    }
+    const Eigen::Vector3d estimate = filter.update(obs);
+    if (t == 0) {
+      EXPECT_EQ(estimate, obs.position_ned_m);
+    }
+    expected.insert(expected.end(), estimate.data(), estimate.data() + 3);
+  }
+  write_raw(dir.path("nav.f64"), records);
+  std::string log;
+  ASSERT_EQ(run({exe, "filter", dir.path("nav.f64"), dir.path("estimates.f64")},
+                dir.path("run.log"), &log),
+            0)
+      << log;
+  EXPECT_LE(max_abs_difference(read_raw<double>(dir.path("estimates.f64")), expected), 1e-9);
+}
+
 TEST(PolicyExportC, DocumentsLayoutScalesAndThrusters) {
   const ExportedPolicy policy = load_exported_policy(kPolicy, vehicle_path(), "");
   const std::string header = policy_c_header(policy);

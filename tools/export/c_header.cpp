@@ -42,6 +42,12 @@ std::string comment_lines(const std::string& text) {
   return out;
 }
 
+/// The share of the distance to the position fix the filter closes each step (0: off).
+double position_filter_gain(const task::TaskConfig& task) {
+  if (!task.position_filter.enabled()) return 0.0;
+  return task::PositionFilter(task.position_filter, task.control_step_s).gain();
+}
+
 /// The header's opening comment: what it holds and how a vehicle uses it.
 std::string opening_comment(const ExportedPolicy& policy) {
   const std::string use =
@@ -57,8 +63,10 @@ std::string opening_comment(const ExportedPolicy& policy) {
       "  double goal_ned_m[3];   (the way-point, NED, m)\n"
       "  float previous[AUVRL_POLICY_NUM_ACTIONS];  (zeros at the start, then the last action)\n"
       "  double offset_ned_m[3];  (zeros at the start of a mission; kept across way-points)\n"
+      "  auvrl_position_filter filter;  (zeros at the start of a mission)\n"
       "  double moved_goal_ned_m[3];\n"
       "  float state[AUVRL_POLICY_STATE_DIM], action[AUVRL_POLICY_NUM_ACTIONS];\n"
+      "  auvrl_policy_filter_position(&filter, &nav);\n"
       "  auvrl_policy_integrate_goal(offset_ned_m, &nav, goal_ned_m, moved_goal_ned_m);\n"
       "  auvrl_policy_build_state(&nav, moved_goal_ned_m, previous, state);\n"
       "  auvrl_policy_act(state, action);\n"
@@ -89,6 +97,9 @@ std::string macros(const ExportedPolicy& policy) {
       "#define AUVRL_POLICY_INTEGRAL_GAIN_PER_S {}\n"
       "#define AUVRL_POLICY_INTEGRAL_RADIUS_M {}\n"
       "#define AUVRL_POLICY_INTEGRAL_MAX_OFFSET_M {}\n"
+      "/* Position filter (auvrl_policy_filter_position): the share of the distance to the\n"
+      " * position fix closed each control step (0: off). */\n"
+      "#define AUVRL_POLICY_POSITION_FILTER_GAIN {}\n"
       "/* Scales: a state entry is the quantity divided by its scale. */\n"
       "#define AUVRL_POLICY_SCALE_POSITION_M {}\n"
       "#define AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS {}\n"
@@ -100,7 +111,8 @@ std::string macros(const ExportedPolicy& policy) {
       c_double_literal(policy.task.max_thrust_n), c_double_literal(policy.task.control_step_s),
       c_double_literal(policy.task.integral.gain_per_s),
       c_double_literal(policy.task.integral.radius_m),
-      c_double_literal(policy.task.integral.max_offset_m), c_double_literal(k.position_m),
+      c_double_literal(policy.task.integral.max_offset_m),
+      c_double_literal(position_filter_gain(policy.task)), c_double_literal(k.position_m),
       c_double_literal(k.linear_velocity_mps), c_double_literal(k.angular_rate_rad_s),
       c_double_literal(k.depth_m));
   for (int i = 0; i < policy.vehicle.num_thrusters(); ++i) {
@@ -196,18 +208,24 @@ std::string paper_state_body() {
          "  for (i = 0; i < AUVRL_POLICY_NUM_THRUSTERS; ++i) state[12 + i] = previous_action[i];\n";
 }
 
+/// C lines that declare `e` (nav's Euler angles) and `r`, the body-to-NED rotation.
+std::string rotation_lines() {
+  return "  const double *e = nav->euler_rpy_rad;\n"
+         "  const double cphi = cos(e[0]), sphi = sin(e[0]);\n"
+         "  const double cth = cos(e[1]), sth = sin(e[1]);\n"
+         "  const double cpsi = cos(e[2]), spsi = sin(e[2]);\n"
+         "  /* Body-to-NED rotation R (Fossen's R(Theta), ZYX). */\n"
+         "  const double r[3][3] = {\n"
+         "      {cpsi * cth, -spsi * cphi + cpsi * sth * sphi, spsi * sphi + cpsi * cphi * sth},\n"
+         "      {spsi * cth, cpsi * cphi + sphi * sth * spsi, -cpsi * sphi + sth * spsi * cphi},\n"
+         "      {-sth, cth * sphi, cth * cphi}};\n";
+}
+
 /// The extended layouts' body of auvrl_policy_build_state.
 std::string extended_state_body(bool with_thrust) {
   std::string out =
-      "  const double *e = nav->euler_rpy_rad;\n"
-      "  const double cphi = cos(e[0]), sphi = sin(e[0]);\n"
-      "  const double cth = cos(e[1]), sth = sin(e[1]);\n"
-      "  const double cpsi = cos(e[2]), spsi = sin(e[2]);\n"
-      "  /* Body-to-NED rotation R (Fossen's R(Theta), ZYX); the body-frame error is R^T e. */\n"
-      "  const double r[3][3] = {\n"
-      "      {cpsi * cth, -spsi * cphi + cpsi * sth * sphi, spsi * sphi + cpsi * cphi * sth},\n"
-      "      {spsi * cth, cpsi * cphi + sphi * sth * spsi, -cpsi * sphi + sth * spsi * cphi},\n"
-      "      {-sth, cth * sphi, cth * cphi}};\n"
+      rotation_lines() +
+      "  /* The body-frame error is R^T e. */\n"
       "  double error_ned[3];\n"
       "  int i;\n"
       "  for (i = 0; i < 3; ++i) error_ned[i] = goal_ned_m[i] - nav->position_ned_m[i];\n"
@@ -292,13 +310,54 @@ std::string integrate_goal_function() {
          "}\n";
 }
 
+/// auvrl_position_filter and auvrl_policy_filter_position: task::PositionFilter in C.
+std::string filter_position_function() {
+  return "/* The position filter, as auvrl's policy controller runs it (task::PositionFilter): once\n"
+         " * per control step, first, it replaces nav->position_ned_m with the estimate that\n"
+         " * auvrl_policy_integrate_goal and auvrl_policy_build_state then take. The estimate moves\n"
+         " * by the measured velocity rotated into NED (trapezoidal over the step), then by\n"
+         " * AUVRL_POLICY_POSITION_FILTER_GAIN of its distance to the fix; the first step takes the\n"
+         " * fix. Zero the struct at the start of a mission. */\n"
+         "typedef struct auvrl_position_filter {\n"
+         "  double position_ned_m[3];   /* the estimate, NED, m */\n"
+         "  double velocity_ned_mps[3]; /* the velocity at the last step, NED, m/s */\n"
+         "  int started;                /* 0 before the first step */\n"
+         "} auvrl_position_filter;\n"
+         "\n"
+         "static inline void auvrl_policy_filter_position(auvrl_position_filter *filter,\n"
+         "                                                auvrl_nav *nav) {\n" +
+         rotation_lines() +
+         "  double velocity_ned_mps[3];\n"
+         "  int i;\n"
+         "  if (!(AUVRL_POLICY_POSITION_FILTER_GAIN > 0.0)) return;\n"
+         "  for (i = 0; i < 3; ++i) {\n"
+         "    velocity_ned_mps[i] = r[i][0] * nav->velocity_body_mps[0] +\n"
+         "                          r[i][1] * nav->velocity_body_mps[1] +\n"
+         "                          r[i][2] * nav->velocity_body_mps[2];\n"
+         "    if (!filter->started) {\n"
+         "      filter->position_ned_m[i] = nav->position_ned_m[i];\n"
+         "    } else {\n"
+         "      filter->position_ned_m[i] += 0.5 * AUVRL_POLICY_CONTROL_STEP_S *\n"
+         "                                   (velocity_ned_mps[i] + filter->velocity_ned_mps[i]);\n"
+         "      filter->position_ned_m[i] +=\n"
+         "          AUVRL_POLICY_POSITION_FILTER_GAIN *\n"
+         "          (nav->position_ned_m[i] - filter->position_ned_m[i]);\n"
+         "    }\n"
+         "    filter->velocity_ned_mps[i] = velocity_ned_mps[i];\n"
+         "    nav->position_ned_m[i] = filter->position_ned_m[i];\n"
+         "  }\n"
+         "  filter->started = 1;\n"
+         "}\n";
+}
+
 }  // namespace
 
 std::string policy_c_header(const ExportedPolicy& policy) {
   return opening_comment(policy) +
          "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
          macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
-         nav_struct(policy) + "\n" + integrate_goal_function() + "\n" +
+         nav_struct(policy) + "\n" + filter_position_function() + "\n" +
+         integrate_goal_function() + "\n" +
          build_state_function(policy) + "\n#endif /* AUVRL_POLICY_H */\n";
 }
 

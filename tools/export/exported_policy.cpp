@@ -193,6 +193,15 @@ std::string describe_policy(const ExportedPolicy& policy) {
                    integral.gain_per_s, policy.task.control_step_s, integral.radius_m,
                    integral.max_offset_m)
              : std::string("Integral action: off (the state is built for the way-point).\n");
+  const task::PositionFilterSettings& filter = policy.task.position_filter;
+  out += filter.enabled()
+             ? fmt::format(
+                   "Position filter: the state and the integral action take the position\n"
+                   "  dead-reckoned from the measured velocity and attitude and pulled toward\n"
+                   "  each position fix with a {} s time constant (auvrl's task::PositionFilter;\n"
+                   "  the C export's auvrl_policy_filter_position).\n",
+                   filter.time_constant_s)
+             : std::string("Position filter: off (the state takes the measured position).\n");
   return out + describe_state_text(policy) + describe_action_text(policy);
 }
 

@@ -19,6 +19,8 @@ struct ExportRequest {
   OnnxWriter onnx;           ///< how to run scripts/export_onnx.py (format "onnx")
   /// The policy's integral action (task::GoalIntegralSettings::gain_per_s; 0: off).
   double integral_gain_per_s = task::GoalIntegralSettings{}.gain_per_s;
+  /// The policy's position filter (task::PositionFilterSettings::time_constant_s; 0: off).
+  double position_filter_s = task::PositionFilterSettings{}.time_constant_s;
 };
 
 /// Loads the policy and the vehicle, writes the header or the model, prints one line saying

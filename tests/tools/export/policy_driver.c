@@ -11,6 +11,10 @@
  *   policy_driver integrate NAV GOALS  float64 records of 6 values (position NED, way-point
  *                                      NED), one control step each, from a zero offset ->
  *                                      float64 moved way-points (auvrl_policy_integrate_goal)
+ *   policy_driver filter NAV POSITIONS float64 records of 9 values (position NED, roll/pitch/
+ *                                      yaw, body velocity), one control step each, from a
+ *                                      zeroed filter -> float64 estimated positions
+ *                                      (auvrl_policy_filter_position)
  *   policy_driver params PARAMS        auvrl_policy_params as float32
  */
 #include <stdio.h>
@@ -63,6 +67,22 @@ static int integrate(FILE *in, FILE *out) {
   return 0;
 }
 
+static int filter_position(FILE *in, FILE *out) {
+  double r[9];
+  auvrl_position_filter filter;
+  auvrl_nav nav;
+  memset(&filter, 0, sizeof filter);
+  memset(&nav, 0, sizeof nav);
+  while (fread(r, sizeof r, 1, in) == 1) {
+    memcpy(nav.position_ned_m, r, sizeof nav.position_ned_m);
+    memcpy(nav.euler_rpy_rad, r + 3, sizeof nav.euler_rpy_rad);
+    memcpy(nav.velocity_body_mps, r + 6, sizeof nav.velocity_body_mps);
+    auvrl_policy_filter_position(&filter, &nav);
+    if (fwrite(nav.position_ned_m, sizeof nav.position_ned_m, 1, out) != 1) return 1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   FILE *in = NULL, *out = NULL;
   int status = 2;
@@ -74,7 +94,7 @@ int main(int argc, char **argv) {
   }
   if (argc != 4) {
     fprintf(stderr,
-            "usage: policy_driver act|state|integrate IN OUT, or policy_driver params OUT\n");
+            "usage: policy_driver act|state|integrate|filter IN OUT, or policy_driver params OUT\n");
     return 2;
   }
   in = fopen(argv[2], "rb");
@@ -83,6 +103,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "act") == 0) status = act(in, out);
     if (strcmp(argv[1], "state") == 0) status = build_state(in, out);
     if (strcmp(argv[1], "integrate") == 0) status = integrate(in, out);
+    if (strcmp(argv[1], "filter") == 0) status = filter_position(in, out);
   } else {
     status = 1;
   }
