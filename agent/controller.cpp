@@ -58,9 +58,11 @@ void PolicyController::act(const task::Observation& observation, const Eigen::Ve
           ? task::advance_goal_integral(task, goal_ned_m, position_ned_m, goal_offset_ned_m_)
           : goal_ned_m;
   moved_state_ = state;
-  task::relabel_state(task, goal_ned_m, shown_goal_ned_m, moved_state_);
   if (position_filter_) {
-    task::shift_position(task, position_ned_m - observation.position_ned_m, moved_state_);
+    task::relabel_state(task, goal_ned_m, shown_goal_ned_m,
+                        position_ned_m - observation.position_ned_m, moved_state_);
+  } else {
+    task::relabel_state(task, goal_ned_m, shown_goal_ned_m, moved_state_);
   }
   action = network_.forward(moved_state_);
 }

@@ -205,10 +205,11 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
   state[kExtDistance] = static_cast<float>(error_body.norm() / c.scales.position_m);
 }
 
-void shift_position(const TaskConfig& c, const Eigen::Vector3d& shift_ned_m,
-                    Eigen::Ref<StateVector> state) {
-  // Further along by the shift is the same error as a goal that much nearer.
-  relabel_state(c, shift_ned_m, Eigen::Vector3d::Zero(), state);
+void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
+                   const Eigen::Vector3d& new_goal, const Eigen::Vector3d& shift_ned_m,
+                   Eigen::Ref<StateVector> state) {
+  // The vehicle further along by the shift sees the goal as if it were that much nearer.
+  relabel_state(c, old_goal, new_goal - shift_ned_m, state);
   if (c.layout == StateLayout::kPaper) {
     state.segment<3>(kPaperPosition) += (shift_ned_m / c.scales.position_m).cast<float>();
   } else {

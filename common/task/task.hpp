@@ -215,10 +215,12 @@ Eigen::Vector3d advance_goal_integral(const TaskConfig& config, const Eigen::Vec
 void relabel_state(const TaskConfig& config, const Eigen::Vector3d& old_goal_ned_m,
                    const Eigen::Vector3d& new_goal_ned_m, Eigen::Ref<StateVector> state);
 
-/// Rewrites an observation vector for the vehicle shift_ned_m further along than it was built
-/// for: the goal error and distance, and the position (paper layout) or depth entries.
-void shift_position(const TaskConfig& config, const Eigen::Vector3d& shift_ned_m,
-                    Eigen::Ref<StateVector> state);
+/// Rewrites an observation vector built for old_goal_ned_m as if built for new_goal_ned_m with
+/// the vehicle shift_ned_m further along: the goal error and distance, and the position (paper
+/// layout) or depth entries (the position filter's estimate in place of the measurement).
+void relabel_state(const TaskConfig& config, const Eigen::Vector3d& old_goal_ned_m,
+                   const Eigen::Vector3d& new_goal_ned_m, const Eigen::Vector3d& shift_ned_m,
+                   Eigen::Ref<StateVector> state);
 
 /// The complementary filter of PositionFilterSettings for one vehicle. Each control step the
 /// estimate moves by the measured velocity rotated into NED by the measured attitude

@@ -294,7 +294,7 @@ TEST(GoalIntegral, UnusableSettingsAreRefusedByName) {
   }
 }
 
-TEST(ShiftPosition, EqualsBuildingTheStateWhereTheVehicleWouldBe) {
+TEST(Relabel, WithAShiftEqualsBuildingTheStateWhereTheVehicleWouldBe) {
   for (StateLayout layout :
        {StateLayout::kPaper, StateLayout::kExtended, StateLayout::kExtendedThrust}) {
     const TaskConfig c = config(layout);
@@ -302,12 +302,12 @@ TEST(ShiftPosition, EqualsBuildingTheStateWhereTheVehicleWouldBe) {
     std::uniform_real_distribution<double> shift(-0.5, 0.5);
     for (int i = 0; i < 500; ++i) {
       Observation obs = random_observation(rng);
-      const Eigen::Vector3d goal(7.0, 6.0, 10.0);
+      const Eigen::Vector3d goal(7.0, 6.0, 10.0), new_goal(6.5, 6.2, 9.0);
       const Eigen::Vector3d by(shift(rng), shift(rng), shift(rng));
       StateVector shifted = build(c, obs, goal, ActionVector::Constant(6, 0.3f));
-      shift_position(c, by, shifted);
+      relabel_state(c, goal, new_goal, by, shifted);
       obs.position_ned_m += by;
-      const StateVector direct = build(c, obs, goal, ActionVector::Constant(6, 0.3f));
+      const StateVector direct = build(c, obs, new_goal, ActionVector::Constant(6, 0.3f));
       EXPECT_LT((shifted - direct).cwiseAbs().maxCoeff(), 2e-6f)
           << to_string(layout) << " sample " << i;
     }
