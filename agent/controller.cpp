@@ -26,7 +26,7 @@ PolicyController::PolicyController(nn::Mlp network, int state_dim, int num_thrus
 
 PolicyController::PolicyController(nn::Mlp network, const task::TaskConfig& task)
     : PolicyController(std::move(network), task.state_dim(), task.num_thrusters) {
-  use_integral_action(task);
+  use_driving_aids(task);
 }
 
 void PolicyController::set_network(nn::Mlp network) {
@@ -34,7 +34,7 @@ void PolicyController::set_network(nn::Mlp network) {
   network_ = std::move(network);
 }
 
-void PolicyController::use_integral_action(const task::TaskConfig& task) {
+void PolicyController::use_driving_aids(const task::TaskConfig& task) {
   driving_task_.reset();
   position_filter_.reset();
   if (task.position_filter.enabled()) {

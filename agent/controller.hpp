@@ -25,7 +25,7 @@ class Controller {
 };
 
 /// The learned policy mu(x | theta): the actor network on the task's observation vector. When
-/// it drives (use_integral_action), it is shown the goal moved by the task's goal integrator
+/// it drives (use_driving_aids), it is shown the goal moved by the task's goal integrator
 /// (task::GoalIntegralSettings) instead of the goal itself, and the position estimated by the
 /// task's position filter (task::PositionFilterSettings) instead of the measured one.
 class PolicyController final : public Controller {
@@ -38,7 +38,7 @@ class PolicyController final : public Controller {
   /// Integral action as task.integral says (off when its gain is 0) and the position filter as
   /// task.position_filter says (off when its time constant is 0). The actors' exploring policy
   /// never uses them; a policy that drives does.
-  void use_integral_action(const task::TaskConfig& task);
+  void use_driving_aids(const task::TaskConfig& task);
   /// Clears the integrator and the position filter (the start of an episode or mission).
   void reset() override {
     goal_offset_ned_m_.setZero();

@@ -3,7 +3,6 @@
 // with other controlled DOF (no pitch, no sway, roll), and its per-vehicle gains files.
 #include <gtest/gtest.h>
 
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -87,7 +86,7 @@ TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
   task::apply_vehicle(nessie().facts(), task);
   const int dim = task.state_dim();
   PolicyController policy(actor(dim, 6), dim, 6);
-  policy.use_integral_action(task);
+  policy.use_driving_aids(task);
   nn::Mlp reference = actor(dim, 6);
   task::Observation obs;
   obs.position_ned_m = Eigen::Vector3d(2.0, 1.0, 6.0);
@@ -112,7 +111,7 @@ TEST(PolicyController, IntegralActionShowsTheNetworkTheMovedGoal) {
   policy.reset();
   EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
   task.integral.gain_per_s = 0.0;
-  policy.use_integral_action(task);
+  policy.use_driving_aids(task);
   policy.act(obs, goal, state, action);
   EXPECT_EQ(action, reference.forward(state));
   EXPECT_EQ(policy.goal_offset_ned_m(), Eigen::Vector3d::Zero());
@@ -152,8 +151,8 @@ TEST(PolicyController, ThePositionFilterShowsTheNetworkTheEstimatedPosition) {
       if (t == 0) {
         EXPECT_EQ(estimated.position_ned_m, obs.position_ned_m);
       }
-      const Eigen::Vector3d shown = task::advance_goal_integral(
-          task, goal, estimated.position_ned_m, expected_offset);
+      const Eigen::Vector3d shown =
+          task::advance_goal_integral(task, goal, estimated.position_ned_m, expected_offset);
       task::build_state(task, estimated, shown, previous, expected_state, thrust_n);
       EXPECT_LE((action - reference.forward(expected_state)).cwiseAbs().maxCoeff(), 1e-5)
           << "gain " << gain_per_s << " step " << t;

@@ -593,8 +593,8 @@ TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
   std::vector<FinetuneEpisode> episodes = finetune_episodes(fast_task(), c, 1);
   agent::PolicyController start(detuned_policy(), fast_task().state_dim(), 6);
   agent::PolicyController best(r.network, fast_task().state_dim(), 6);
-  start.use_integral_action(fast_task());
-  best.use_integral_action(fast_task());
+  start.use_driving_aids(fast_task());
+  best.use_driving_aids(fast_task());
   double start_without_pid = 0.0;
   for (const FinetuneEpisode& e : episodes) {
     start_without_pid += arrival_objective(nessie(), fast_task(), start, e, c);

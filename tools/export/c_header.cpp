@@ -312,12 +312,13 @@ std::string integrate_goal_function() {
 
 /// auvrl_position_filter and auvrl_policy_filter_position: task::PositionFilter in C.
 std::string filter_position_function() {
-  return "/* The position filter, as auvrl's policy controller runs it (task::PositionFilter): once\n"
-         " * per control step, first, it replaces nav->position_ned_m with the estimate that\n"
-         " * auvrl_policy_integrate_goal and auvrl_policy_build_state then take. The estimate moves\n"
-         " * by the measured velocity rotated into NED (trapezoidal over the step), then by\n"
-         " * AUVRL_POLICY_POSITION_FILTER_GAIN of its distance to the fix; the first step takes the\n"
-         " * fix. Zero the struct at the start of a mission. */\n"
+  return "/* The position filter, as auvrl's policy controller runs it\n"
+         " * (task::PositionFilter): once per control step, first, it replaces\n"
+         " * nav->position_ned_m with the estimate that auvrl_policy_integrate_goal and\n"
+         " * auvrl_policy_build_state then take. The estimate moves by the measured velocity\n"
+         " * rotated into NED (trapezoidal over the step), then by\n"
+         " * AUVRL_POLICY_POSITION_FILTER_GAIN of its distance to the fix; the first step\n"
+         " * takes the fix. Zero the struct at the start of a mission. */\n"
          "typedef struct auvrl_position_filter {\n"
          "  double position_ned_m[3];   /* the estimate, NED, m */\n"
          "  double velocity_ned_mps[3]; /* the velocity at the last step, NED, m/s */\n"
@@ -356,9 +357,8 @@ std::string policy_c_header(const ExportedPolicy& policy) {
   return opening_comment(policy) +
          "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
          macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
-         nav_struct(policy) + "\n" + filter_position_function() + "\n" +
-         integrate_goal_function() + "\n" +
-         build_state_function(policy) + "\n#endif /* AUVRL_POLICY_H */\n";
+         nav_struct(policy) + "\n" + filter_position_function() + "\n" + integrate_goal_function() +
+         "\n" + build_state_function(policy) + "\n#endif /* AUVRL_POLICY_H */\n";
 }
 
 }  // namespace auvrl::tools
