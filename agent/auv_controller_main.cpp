@@ -26,8 +26,7 @@ int main(int argc, char** argv) {
   cmd.option("vehicle", &options.vehicle_path,
              "vehicle file (default: the mission's vehicle:, else config/vehicles/nessie7.yaml)");
   cmd.option("layout", &options.layout, "state layout (default: inferred from the policy)");
-  auvrl::task::add_integral_gain_option(cmd, options.integral_gain_per_s);
-  auvrl::task::add_position_filter_option(cmd, options.position_filter_s);
+  auvrl::task::add_driving_aid_options(cmd, options.driving);
   cmd.option("trust-key", &options.trust_key,
              "Ed25519 public key (PEM): the mission and the policy must be signed by its private "
              "key (FILE.sig beside each; auvrl sign), else they are refused");

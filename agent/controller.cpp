@@ -58,12 +58,9 @@ void PolicyController::act(const task::Observation& observation, const Eigen::Ve
           ? task::advance_goal_integral(task, goal_ned_m, position_ned_m, goal_offset_ned_m_)
           : goal_ned_m;
   moved_state_ = state;
-  if (position_filter_) {
-    task::relabel_state(task, goal_ned_m, shown_goal_ned_m,
-                        position_ned_m - observation.position_ned_m, moved_state_);
-  } else {
-    task::relabel_state(task, goal_ned_m, shown_goal_ned_m, moved_state_);
-  }
+  // Zero shift without the filter: the state's position entries stay the measured ones.
+  task::relabel_state(task, goal_ned_m, shown_goal_ned_m,
+                      position_ned_m - observation.position_ned_m, moved_state_);
   action = network_.forward(moved_state_);
 }
 

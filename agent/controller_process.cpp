@@ -40,8 +40,7 @@ ControllerSetup load_controller_setup(const ControllerProcessOptions& options) {
     }
     std::optional<task::StateLayout> layout;
     if (!options.layout.empty()) layout = task::parse_layout(options.layout);
-    setup.task.integral.gain_per_s = options.integral_gain_per_s;
-    setup.task.position_filter.time_constant_s = options.position_filter_s;
+    options.driving.apply(setup.task);
     setup.controller = load_policy(options.policy_path, setup.model.name,
                                    setup.model.num_thrusters(), layout, setup.task);
   } else {

@@ -19,10 +19,8 @@ struct ControllerProcessOptions {
   std::string controller = "policy";  ///< "policy" or "pid"
   std::string vehicle_path;           ///< "": the mission's vehicle:, else default_vehicle_file()
   std::string layout;                 ///< "": inferred from the policy's input size
-  /// The policy's integral action (task::GoalIntegralSettings::gain_per_s; 0: off).
-  double integral_gain_per_s = task::GoalIntegralSettings{}.gain_per_s;
-  /// The policy's position filter (task::PositionFilterSettings::time_constant_s; 0: off).
-  double position_filter_s = task::PositionFilterSettings{}.time_constant_s;
+  /// The policy's integral action and position filter.
+  task::DrivingAidOptions driving = {};
   /// An Ed25519 public key (PEM): the mission and the policy must then be signed by its
   /// private key (FILE.sig beside each, common/signature.hpp), or they are refused.
   std::string trust_key;

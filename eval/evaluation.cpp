@@ -459,8 +459,7 @@ std::unique_ptr<agent::Controller> make_eval_controller(const EvalRequest& reque
   }
   std::optional<task::StateLayout> layout;
   if (!request.layout.empty()) layout = config.task.layout;
-  config.task.integral.gain_per_s = request.integral_gain_per_s;
-  config.task.position_filter.time_constant_s = request.position_filter_s;
+  request.driving.apply(config.task);
   return agent::load_policy(request.policy_path, model.name, n, layout, config.task);
 }
 

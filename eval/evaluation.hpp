@@ -201,10 +201,8 @@ struct EvalRequest {
   /// scenarios.
   std::string mission_path;
   std::string layout;  ///< "paper", "extended", "extended_thrust" or empty: from the policy
-  /// The policy's integral action (task::GoalIntegralSettings::gain_per_s; 0: off).
-  double integral_gain_per_s = task::GoalIntegralSettings{}.gain_per_s;
-  /// The policy's position filter (task::PositionFilterSettings::time_constant_s; 0: off).
-  double position_filter_s = task::PositionFilterSettings{}.time_constant_s;
+  /// The policy's integral action and position filter.
+  task::DrivingAidOptions driving = {};
   std::uint64_t seed = 1;
   int suite_episodes = 100;
   int suite_trajectories = 10;

@@ -66,8 +66,7 @@ int run_eval(int argc, const char* const* argv) {
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
-  auvrl::task::add_integral_gain_option(cli, request.integral_gain_per_s);
-  auvrl::task::add_position_filter_option(cli, request.position_filter_s);
+  auvrl::task::add_driving_aid_options(cli, request.driving);
   cli.option("seed", &seed, "seed of the suite's way-points and the vehicle resets");
   cli.check("seed", auvrl::cli::at_least(0));
   cli.option("suite-episodes", &request.suite_episodes, "way-points in the suite");
@@ -142,8 +141,7 @@ int run_export(int argc, const char* const* argv) {
   cli.option("layout", &request.layout,
              "paper|extended|extended_thrust (default: from the policy's inputs, 12+n / 17+n "
              "/ 17+2n)");
-  auvrl::task::add_integral_gain_option(cli, request.integral_gain_per_s);
-  auvrl::task::add_position_filter_option(cli, request.position_filter_s);
+  auvrl::task::add_driving_aid_options(cli, request.driving);
   if (!cli.parse(argc, argv)) return 0;
   auvrl::tools::run_export_request(request, std::cout);
   return 0;

@@ -217,6 +217,11 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
   }
 }
 
+void DrivingAidOptions::apply(TaskConfig& task) const {
+  task.integral.gain_per_s = integral_gain_per_s;
+  task.position_filter.time_constant_s = position_filter_s;
+}
+
 PositionFilter::PositionFilter(const PositionFilterSettings& settings, double control_step_s)
     : control_step_s_(control_step_s),
       gain_(-std::expm1(-control_step_s / settings.time_constant_s)) {

@@ -170,6 +170,16 @@ struct TaskConfig {
   void validate() const;
 };
 
+/// What a policy that drives adds to its network (task.integral, task.position_filter), as the
+/// programs that drive a policy from a file (`auvrl eval`, `auvrl export`, `auv_controller`)
+/// take it from their command line.
+struct DrivingAidOptions {
+  double integral_gain_per_s = GoalIntegralSettings{}.gain_per_s;       ///< 1/s, 0: off
+  double position_filter_s = PositionFilterSettings{}.time_constant_s;  ///< s, 0: off
+  /// Sets task.integral.gain_per_s and task.position_filter.time_constant_s.
+  void apply(TaskConfig& task) const;
+};
+
 /// Sets the fields the vehicle decides: thruster count, maximum thrust, control step.
 void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task);
 

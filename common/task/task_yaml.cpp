@@ -197,14 +197,11 @@ const config::Table<GoalScheduleConfig>& goal_schedule_table() {
   return table;
 }
 
-void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s) {
-  cmd.option("integral-gain", &gain_per_s,
+void add_driving_aid_options(cli::CommandLine& cmd, DrivingAidOptions& options) {
+  cmd.option("integral-gain", &options.integral_gain_per_s,
              "the policy's integral action, 1/s (0: off; docs/usage.md, \"Integral action\")");
   cmd.check("integral-gain", CLI::Range(0.0, GoalIntegralSettings::kMaxGainPerS));
-}
-
-void add_position_filter_option(cli::CommandLine& cmd, double& time_constant_s) {
-  cmd.option("position-filter", &time_constant_s,
+  cmd.option("position-filter", &options.position_filter_s,
              "the policy's position filter, time constant in s (0: off; docs/usage.md, "
              "\"Position filter\")");
   cmd.check("position-filter", CLI::Range(0.0, PositionFilterSettings::kMaxTimeConstantS));

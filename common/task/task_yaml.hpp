@@ -1,6 +1,6 @@
 // The `task:` and `schedule:` sections of a run configuration (config/presets/*.yaml), read
-// through their tables (task_table(), goal_schedule_table()), and the task's one command-line
-// option.
+// through their tables (task_table(), goal_schedule_table()), and the task's command-line
+// options.
 #pragma once
 
 #include "common/config/yaml_config.hpp"
@@ -13,14 +13,9 @@ class CommandLine;
 
 namespace auvrl::task {
 
-/// `--integral-gain PER_S` (task.integral.gain_per_s, 0: off, checked against
-/// GoalIntegralSettings::kMaxGainPerS), for the programs that drive a policy from a file
-/// (`auvrl eval`, `auvrl export`, `auv_controller`).
-void add_integral_gain_option(cli::CommandLine& cmd, double& gain_per_s);
-
-/// `--position-filter S` (task.position_filter.time_constant_s, 0: off, checked against
-/// PositionFilterSettings::kMaxTimeConstantS), for the same programs.
-void add_position_filter_option(cli::CommandLine& cmd, double& time_constant_s);
+/// `--integral-gain PER_S` and `--position-filter S` into a DrivingAidOptions, checked against
+/// GoalIntegralSettings::kMaxGainPerS and PositionFilterSettings::kMaxTimeConstantS.
+void add_driving_aid_options(cli::CommandLine& cmd, DrivingAidOptions& options);
 
 /// Fills `config` from a `task:` section (keys named as the TaskConfig members; absent keys
 /// keep their values) and validates it. Throws config::ConfigError naming file and key.

@@ -481,6 +481,28 @@ TEST(RobustnessMargins, PairsEpisodesAgainstTheBarsThresholds) {
   }
 }
 
+/// The committed policy (config/policies/fast.nn) driving `config`'s task (its layout set from
+/// the policy) on each episode; each must reach its way-point.
+std::vector<SummaryRow> committed_policy_rows(EvaluationConfig config,
+                                              const std::vector<EvaluationEpisode>& episodes) {
+  auto policy = agent::load_policy(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
+                                   nessie().name, 6, std::nullopt, config.task);
+  std::vector<SummaryRow> rows;
+  for (const EvaluationEpisode& e : episodes) {
+    rows.push_back(run_evaluation_episode(nessie(), config, *policy, e, nullptr));
+    EXPECT_TRUE(rows.back().reached) << e.index;
+  }
+  return rows;
+}
+
+/// The mean of one figure over rows.
+template <typename Figure>
+double mean_of(const std::vector<SummaryRow>& rows, Figure figure) {
+  double sum = 0.0;
+  for (const SummaryRow& row : rows) sum += figure(row);
+  return sum / static_cast<double>(rows.size());
+}
+
 // The policy's integral action (task.integral) drives out what a steady push leaves: the
 // committed policy against 2 kg of extra buoyancy holds closer with it than without it.
 TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
@@ -492,15 +514,8 @@ TEST(RobustnessRun, IntegralActionHoldsCloserAgainstExtraBuoyancy) {
   const auto mean_hold_m = [&](double gain_per_s) {
     EvaluationConfig with = c;
     with.task.integral.gain_per_s = gain_per_s;
-    auto policy = agent::load_policy(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
-                                     nessie().name, 6, std::nullopt, with.task);
-    double sum = 0.0;
-    for (const EvaluationEpisode& e : episodes) {
-      const SummaryRow row = run_evaluation_episode(nessie(), with, *policy, e, nullptr);
-      EXPECT_TRUE(row.reached) << e.index;
-      sum += row.mean_error_after_reach_m;
-    }
-    return sum / static_cast<double>(episodes.size());
+    return mean_of(committed_policy_rows(with, episodes),
+                   [](const SummaryRow& r) { return r.mean_error_after_reach_m; });
   };
   const double without_m = mean_hold_m(0.0), with_m = mean_hold_m(0.1);
   std::cout << "mean hold error with 2 kg of extra buoyancy: " << without_m
@@ -517,29 +532,19 @@ TEST(RobustnessRun, ThePositionFilterCalmsTheCommandsUnderSensorNoise) {
   const std::vector<EvaluationEpisode> episodes =
       of_group(robustness_episodes(c, 6, 4, 1), "sensor_noise");
   ASSERT_EQ(episodes.size(), 4u);
-  struct Means {
-    double smoothness = 0.0, energy = 0.0;
-  };
-  const auto means = [&](double time_constant_s) {
+  const auto rows = [&](double time_constant_s) {
     EvaluationConfig with = c;
     with.task.position_filter.time_constant_s = time_constant_s;
-    auto policy = agent::load_policy(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
-                                     nessie().name, 6, std::nullopt, with.task);
-    Means m;
-    for (const EvaluationEpisode& e : episodes) {
-      const SummaryRow row = run_evaluation_episode(nessie(), with, *policy, e, nullptr);
-      EXPECT_TRUE(row.reached) << e.index;
-      m.smoothness += row.smoothness / static_cast<double>(episodes.size());
-      m.energy += row.thrust_energy / static_cast<double>(episodes.size());
-    }
-    return m;
+    return committed_policy_rows(with, episodes);
   };
-  const Means without = means(0.0), with = means(0.5);
-  std::cout << "under sensor noise: smoothness " << without.smoothness << " without the position "
-            << "filter, " << with.smoothness << " with it; energy " << without.energy << ", "
-            << with.energy << "\n";
-  EXPECT_LT(with.smoothness, 0.8 * without.smoothness);
-  EXPECT_LT(with.energy, 0.9 * without.energy);
+  const auto smoothness = [](const SummaryRow& r) { return r.smoothness; };
+  const auto energy = [](const SummaryRow& r) { return r.thrust_energy; };
+  const std::vector<SummaryRow> without = rows(0.0), with = rows(0.5);
+  std::cout << "under sensor noise: smoothness " << mean_of(without, smoothness)
+            << " without the position filter, " << mean_of(with, smoothness) << " with it; energy "
+            << mean_of(without, energy) << ", " << mean_of(with, energy) << "\n";
+  EXPECT_LT(mean_of(with, smoothness), 0.8 * mean_of(without, smoothness));
+  EXPECT_LT(mean_of(with, energy), 0.9 * mean_of(without, energy));
 }
 
 TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {

@@ -20,8 +20,7 @@ void run_export_request(const ExportRequest& request, std::ostream& out) {
   }
   ExportedPolicy policy =
       load_exported_policy(request.policy_path, request.vehicle_path, request.layout);
-  policy.task.integral.gain_per_s = request.integral_gain_per_s;
-  policy.task.position_filter.time_constant_s = request.position_filter_s;
+  request.driving.apply(policy.task);
   std::string what;
   if (request.format == "c") {
     const std::string header = policy_c_header(policy);

@@ -17,10 +17,8 @@ struct ExportRequest {
   std::string vehicle_path;  ///< vehicle file: thruster names, maximum thrust, thruster count
   std::string layout;        ///< "paper", "extended", "extended_thrust" or empty: inferred
   OnnxWriter onnx;           ///< how to run scripts/export_onnx.py (format "onnx")
-  /// The policy's integral action (task::GoalIntegralSettings::gain_per_s; 0: off).
-  double integral_gain_per_s = task::GoalIntegralSettings{}.gain_per_s;
-  /// The policy's position filter (task::PositionFilterSettings::time_constant_s; 0: off).
-  double position_filter_s = task::PositionFilterSettings{}.time_constant_s;
+  /// The policy's integral action and position filter.
+  task::DrivingAidOptions driving = {};
 };
 
 /// Loads the policy and the vehicle, writes the header or the model, prints one line saying
