@@ -42,14 +42,27 @@ void PolicyController::use_driving_aids(const task::TaskConfig& task) {
   }
   if (task.integral.enabled() || position_filter_) driving_task_ = task;
   goal_offset_ned_m_.setZero();
+  fault_accommodation_.reset();
+  // Only the extended_thrust layout shows the controller what each thruster delivers.
+  if (task.fault_accommodation.enabled && task.layout == task::StateLayout::kExtendedThrust) {
+    fault_accommodation_.emplace(task);
+  }
 }
 
 void PolicyController::act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
                            const task::StateVector& state, task::ActionVector& action) {
-  if (!driving_task_) {
+  if (driving_task_) {
+    act_on_estimates(observation, goal_ned_m, state, action);
+  } else {
     action = network_.forward(state);
-    return;
   }
+  if (fault_accommodation_) fault_accommodation_->apply(state, action);
+}
+
+void PolicyController::act_on_estimates(const task::Observation& observation,
+                                        const Eigen::Vector3d& goal_ned_m,
+                                        const task::StateVector& state,
+                                        task::ActionVector& action) {
   const task::TaskConfig& task = *driving_task_;
   const Eigen::Vector3d position_ned_m =
       position_filter_ ? position_filter_->update(observation) : observation.position_ned_m;

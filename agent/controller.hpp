@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/nn/mlp.hpp"
+#include "common/task/fault_accommodation.hpp"
 #include "common/task/task.hpp"
 
 namespace auvrl::agent {
@@ -27,22 +28,25 @@ class Controller {
 /// The learned policy mu(x | theta): the actor network on the task's observation vector. When
 /// it drives (use_driving_aids), it is shown the goal moved by the task's goal integrator
 /// (task::GoalIntegralSettings) instead of the goal itself, and the position estimated by the
-/// task's position filter (task::PositionFilterSettings) instead of the measured one.
+/// task's position filter (task::PositionFilterSettings) instead of the measured one, and its
+/// commands pass the task's thruster fault accommodation (task::ThrusterFaultAccommodation).
 class PolicyController final : public Controller {
  public:
   /// Throws std::invalid_argument if the network's input/output sizes do not match.
   PolicyController(nn::Mlp network, int state_dim, int num_thrusters);
-  /// A policy that drives: sizes from the task, integral action and position filter as
-  /// task.integral and task.position_filter say.
+  /// A policy that drives: sizes from the task, its driving aids as use_driving_aids says.
   PolicyController(nn::Mlp network, const task::TaskConfig& task);
-  /// Integral action as task.integral says (off when its gain is 0) and the position filter as
-  /// task.position_filter says (off when its time constant is 0). The actors' exploring policy
+  /// Integral action as task.integral says (off when its gain is 0), the position filter as
+  /// task.position_filter says (off when its time constant is 0) and fault accommodation as
+  /// task.fault_accommodation says (extended_thrust layout only). The actors' exploring policy
   /// never uses them; a policy that drives does.
   void use_driving_aids(const task::TaskConfig& task);
-  /// Clears the integrator and the position filter (the start of an episode or mission).
+  /// Clears the integrator, the position filter and the thrusters found dead (the start of an
+  /// episode or mission).
   void reset() override {
     goal_offset_ned_m_.setZero();
     if (position_filter_) position_filter_->reset();
+    if (fault_accommodation_) fault_accommodation_->reset();
   }
   void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
            const task::StateVector& state, task::ActionVector& action) override;
@@ -52,13 +56,22 @@ class PolicyController final : public Controller {
   /// Replaces the network (new weights from the learner); same size checks.
   void set_network(nn::Mlp network);
   const nn::Mlp& network() const { return network_; }
+  /// The fault accommodation at work, or null (off, or a layout without the realised thrust).
+  const task::ThrusterFaultAccommodation* fault_accommodation() const {
+    return fault_accommodation_ ? &*fault_accommodation_ : nullptr;
+  }
 
  private:
   nn::Mlp network_;
   int state_dim_;
   int num_thrusters_;
+  /// The network on the state with the integrator's goal and the filter's position.
+  void act_on_estimates(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
+                        const task::StateVector& state, task::ActionVector& action);
+
   std::optional<task::TaskConfig> driving_task_;  ///< set when integral action or filter is on
   std::optional<task::PositionFilter> position_filter_;
+  std::optional<task::ThrusterFaultAccommodation> fault_accommodation_;
   Eigen::Vector3d goal_offset_ned_m_ = Eigen::Vector3d::Zero();
   task::StateVector moved_state_;
 };

@@ -77,7 +77,7 @@ std::vector<ObjectiveTermsRow> objective_terms_rows(
   for (const auto& [name, net] : {std::pair<const char*, const nn::Mlp*>{"start", &start},
                                   {"finetuned", kept ? &*kept : nullptr}}) {
     if (net == nullptr) continue;
-    agent::PolicyController policy(*net, in.task);
+    agent::PolicyController policy(*net, tuning::finetune_driving_task(in.task));  // as searched
     rows.push_back(
         {name, tuning::mean_objective_terms(in.model, in.task, policy, episodes, in.config)});
   }

@@ -495,6 +495,11 @@ VehicleFacts VehicleModel::facts() const {
   for (const Thruster& t : thrusters) f.thruster_names.push_back(t.name);
   f.max_thrust_n = thruster_dynamics.max_thrust_n;
   f.control_step_s = control_step_s;
+  f.thruster_dynamics = thruster_dynamics;
+  for (Eigen::Index i = 0; i < allocation.cols(); ++i) {
+    ThrusterWrench& w = f.thruster_wrench.emplace_back();
+    for (int k = 0; k < 6; ++k) w[static_cast<std::size_t>(k)] = allocation(k, i);
+  }
   return f;
 }
 

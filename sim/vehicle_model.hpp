@@ -52,15 +52,8 @@ struct Thruster {
   Vector3 direction_body = Vector3::UnitX();  ///< unit vector of positive thrust
 };
 
-/// Thruster response as identified on the real vehicle; each effect can be switched off.
-struct ThrusterDynamics {
-  double max_thrust_n = 39.24;        ///< symmetric saturation |f| <= max, per thruster
-  bool delay_enabled = true;          ///< one control-step (sample) delay of the command
-  bool lag_enabled = true;            ///< first-order low-pass on the realised thrust
-  double lag_time_constant_s = 0.29;  ///< time constant of that low-pass
-  bool slew_enabled = true;           ///< rate limit on the realised thrust
-  double slew_rate_n_per_s = 21.6;    ///< 5.5 % of full throttle per 0.1 s, in N/s
-};
+/// Thruster response (common/vehicle_facts.hpp: the task models a healthy thruster with it).
+using ThrusterDynamics = auvrl::ThrusterDynamics;
 
 /// The body DOF in the allocation's row order.
 enum Axis : int { kSurge = 0, kSway = 1, kHeave = 2, kRoll = 3, kPitch = 4, kYaw = 5 };

@@ -343,6 +343,12 @@ ObjectiveTerms mean_objective_terms(const sim::VehicleModel& model, const task::
   return mean;
 }
 
+task::TaskConfig finetune_driving_task(const task::TaskConfig& task) {
+  task::TaskConfig t = task;
+  t.fault_accommodation.enabled = false;
+  return t;
+}
+
 FinetuneResult finetune_policy(
     const sim::VehicleModel& model, const task::TaskConfig& task, const nn::Mlp& start,
     const FinetuneConfig& config, std::uint64_t seed,
@@ -358,7 +364,7 @@ FinetuneResult finetune_policy(
                                    : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
   threads = std::min(threads, 2 * config.pairs);
   std::vector<agent::PolicyController> workers;
-  for (int w = 0; w < threads; ++w) workers.emplace_back(start, task);
+  for (int w = 0; w < threads; ++w) workers.emplace_back(start, finetune_driving_task(task));
   nn::Mlp scratch = start;
 
   // Mean objective of weights theta, with controller c (its network replaced).

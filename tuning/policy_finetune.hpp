@@ -185,6 +185,12 @@ std::vector<FinetuneEpisode> objective_episodes(const sim::VehicleModel& model,
                                                 const task::TaskConfig& task,
                                                 const FinetuneConfig& config, std::uint64_t seed);
 
+/// The task as the fine-tuning drives a policy in its episodes: the task's driving aids but
+/// its fault accommodation, which is off. The network learns to live with a dead thruster
+/// itself (the faulted way-points); the accommodation comes on top wherever the policy drives
+/// (docs/usage.md, "Fault accommodation").
+task::TaskConfig finetune_driving_task(const task::TaskConfig& task);
+
 /// Each price's mean over the episodes for a controller, s.
 ObjectiveTerms mean_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
                                     agent::Controller& controller,
@@ -209,7 +215,8 @@ struct FinetuneResult {
   std::vector<FinetuneEpisode> episodes;
 };
 
-/// Fine-tunes `start` (an actor network for the task's layout) for the task; deterministic for
+/// Fine-tunes `start` (an actor network for the task's layout) for the task, driving it as
+/// finetune_driving_task says; deterministic for
 /// a seed whatever the number of threads. progress (may be empty) is called after each
 /// iteration with its figures and the updated weights; stop (may be empty) before each, and
 /// true ends the fine-tuning there. Throws

@@ -108,6 +108,14 @@ void TaskConfig::validate() const {
         fmt::format("task.position_filter.time_constant_s must be in [0, {}] (s), got {}",
                     PositionFilterSettings::kMaxTimeConstantS, position_filter.time_constant_s));
   }
+  const FaultAccommodationSettings& fa = fault_accommodation;
+  if (!(fa.dead_below >= 0 && fa.dead_below < 1)) {
+    throw std::invalid_argument(
+        fmt::format("task.fault_accommodation.dead_below must be in [0, 1) (an efficiency), got {}",
+                    fa.dead_below));
+  }
+  positive(fa.estimate_time_constant_s, "fault_accommodation.estimate_time_constant_s");
+  positive(fa.damping, "fault_accommodation.damping");
   if (!(integral.max_offset_m >= 0) || !std::isfinite(integral.max_offset_m)) {
     throw std::invalid_argument("task.integral.max_offset_m must be finite and >= 0");
   }
@@ -220,6 +228,7 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
 void DrivingAidOptions::apply(TaskConfig& task) const {
   task.integral.gain_per_s = integral_gain_per_s;
   task.position_filter.time_constant_s = position_filter_s;
+  task.fault_accommodation.enabled = fault_accommodation;
 }
 
 PositionFilter::PositionFilter(const PositionFilterSettings& settings, double control_step_s)
@@ -257,6 +266,22 @@ Eigen::Vector3d advance_goal_integral(const TaskConfig& c, const Eigen::Vector3d
     if (length_m > s.max_offset_m) offset_ned_m *= s.max_offset_m / length_m;
   }
   return goal_ned_m + offset_ned_m;
+}
+
+void previous_action_from_state(const TaskConfig& c, const Eigen::Ref<const StateVector>& state,
+                                Eigen::VectorXd& previous_action) {
+  const int first = c.layout == StateLayout::kPaper ? kPaperAction : kExtAction;
+  previous_action = state.segment(first, c.num_thrusters).cast<double>();
+}
+
+void realised_thrust_from_state(const TaskConfig& c, const Eigen::Ref<const StateVector>& state,
+                                Eigen::VectorXd& thrust_realised_n) {
+  if (c.layout != StateLayout::kExtendedThrust) {
+    throw std::invalid_argument(std::string("realised_thrust_from_state: the ") +
+                                to_string(c.layout) + " layout does not carry the realised thrust");
+  }
+  const int first = kExtAction + c.num_thrusters + 1;  // as build_state writes it
+  thrust_realised_n = state.segment(first, c.num_thrusters).cast<double>() * c.max_thrust_n;
 }
 
 Eigen::Vector3d position_from_state(const TaskConfig& c, const Eigen::Vector3d& goal,
@@ -368,6 +393,8 @@ void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task) {
   task.num_thrusters = vehicle.num_thrusters();
   task.max_thrust_n = vehicle.max_thrust_n;
   task.control_step_s = vehicle.control_step_s;
+  task.thruster_dynamics = vehicle.thruster_dynamics;
+  task.thruster_wrench = vehicle.thruster_wrench;
 }
 
 StateLayout infer_layout(int input_dim, int num_thrusters) {

@@ -97,6 +97,26 @@ struct PositionFilterSettings {
   bool enabled() const { return time_constant_s > 0.0; }
 };
 
+/// Thruster fault accommodation for a driving policy (evaluation, fine-tuning, missions,
+/// deployment; never the actors' training episodes; task::ThrusterFaultAccommodation): each
+/// thruster's efficiency is estimated from its realised thrust against a healthy thruster's
+/// response to the same commands; once it falls below dead_below the thruster is dead until
+/// the next reset: it is no longer commanded, and its share of the policy's body wrench goes
+/// to the others in damped least squares. Needs the extended_thrust layout (the realised
+/// thrust); the other layouts drive without it.
+struct FaultAccommodationSettings {
+  bool enabled = true;
+  /// Estimated efficiency (realised over a healthy thruster's thrust) below which a thruster
+  /// counts as dead. Weak thrusters above it keep the policy's commands.
+  double dead_below = 0.05;
+  /// Time constant of the efficiency estimate, s.
+  double estimate_time_constant_s = 2.0;
+  /// Damping of the redistribution, relative to the mean squared column of the thrusters'
+  /// wrench matrix: small values rebuild the whole wrench with the remaining thrusters, large
+  /// ones only stop commanding the dead thruster.
+  double damping = 1.0;
+};
+
 /// Every constant of the task. Defaults are the paper's where it gives one.
 struct TaskConfig {
   StateLayout layout = StateLayout::kPaper;
@@ -106,6 +126,8 @@ struct TaskConfig {
   int num_thrusters = 6;
   double max_thrust_n = 39.24;  ///< action +-1 maps to +-this, N
   double control_step_s = 0.1;
+  ThrusterDynamics thruster_dynamics;           ///< the thrusters' response
+  std::vector<ThrusterWrench> thruster_wrench;  ///< per thruster; empty until apply_vehicle
 
   RewardKind reward = RewardKind::kPaper;
   double goal_reward = 10.0;  ///< on reaching the goal radius beta
@@ -163,6 +185,8 @@ struct TaskConfig {
   GoalIntegralSettings integral;
   /// The driving policy's position estimate (not the paper's: its preset turns it off).
   PositionFilterSettings position_filter;
+  /// The driving policy's answer to a dead thruster (not the paper's: its preset turns it off).
+  FaultAccommodationSettings fault_accommodation;
 
   /// Size of the observation vector.
   int state_dim() const;
@@ -170,17 +194,20 @@ struct TaskConfig {
   void validate() const;
 };
 
-/// What a policy that drives adds to its network (task.integral, task.position_filter), as the
-/// programs that drive a policy from a file (`auvrl eval`, `auvrl export`, `auv_controller`)
-/// take it from their command line.
+/// What a policy that drives adds to its network (task.integral, task.position_filter,
+/// task.fault_accommodation), as the programs that drive a policy from a file (`auvrl eval`,
+/// `auvrl export`, `auv_controller`) take it from their command line.
 struct DrivingAidOptions {
   double integral_gain_per_s = GoalIntegralSettings{}.gain_per_s;       ///< 1/s, 0: off
   double position_filter_s = PositionFilterSettings{}.time_constant_s;  ///< s, 0: off
-  /// Sets task.integral.gain_per_s and task.position_filter.time_constant_s.
+  bool fault_accommodation = FaultAccommodationSettings{}.enabled;
+  /// Sets task.integral.gain_per_s, task.position_filter.time_constant_s and
+  /// task.fault_accommodation.enabled.
   void apply(TaskConfig& task) const;
 };
 
-/// Sets the fields the vehicle decides: thruster count, maximum thrust, control step.
+/// Sets the fields the vehicle decides: thruster count, maximum thrust, control step, the
+/// thrusters' response and wrenches.
 void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task);
 
 /// The keys of a `task:` section (common/task/task_yaml.cpp).
@@ -253,6 +280,16 @@ class PositionFilter {
   Eigen::Vector3d position_ned_m_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_ned_mps_ = Eigen::Vector3d::Zero();  ///< at the last update
 };
+
+/// The previous action (normalised commands) an observation vector carries, any layout.
+void previous_action_from_state(const TaskConfig& config,
+                                const Eigen::Ref<const StateVector>& state,
+                                Eigen::VectorXd& previous_action);
+/// The realised thrust (N per thruster) an extended_thrust observation vector carries. Throws
+/// std::invalid_argument for the other layouts (they do not carry it).
+void realised_thrust_from_state(const TaskConfig& config,
+                                const Eigen::Ref<const StateVector>& state,
+                                Eigen::VectorXd& thrust_realised_n);
 
 /// Vehicle position encoded in an observation vector built for goal_ned_m.
 Eigen::Vector3d position_from_state(const TaskConfig& config, const Eigen::Vector3d& goal_ned_m,

@@ -109,6 +109,27 @@ config::Table<PositionFilterSettings> make_position_filter_table() {
   return t;
 }
 
+config::Table<FaultAccommodationSettings> make_fault_accommodation_table() {
+  using F = FaultAccommodationSettings;
+  config::Table<F> t("fault_accommodation",
+                     "a driving policy's answer to a dead thruster (evaluation, fine-tuning, "
+                     "missions, deployment; not the actors' training episodes; extended_thrust "
+                     "layout): detected from its realised thrust, no longer commanded, its share "
+                     "of the wrench given to the others");
+  t.field("enabled", &F::enabled, "", "accommodate dead thrusters when a policy drives");
+  t.field("dead_below", &F::dead_below, "efficiency",
+          "a thruster whose estimated efficiency falls below this counts as dead")
+      .range(0.0, 1.0);
+  t.field("estimate_time_constant_s", &F::estimate_time_constant_s, "s",
+          "time constant of the efficiency estimate")
+      .positive();
+  t.field("damping", &F::damping, "",
+          "damping of the redistribution (small: rebuild the whole wrench; large: only stop "
+          "commanding the dead thruster)")
+      .positive();
+  return t;
+}
+
 /// The reward's terms.
 void add_reward_fields(config::Table<TaskConfig>& t) {
   using C = TaskConfig;
@@ -157,6 +178,7 @@ void add_episode_fields(config::Table<TaskConfig>& t) {
   t.section("randomise", randomise_table(), &C::randomise);
   t.section("integral", make_integral_table(), &C::integral);
   t.section("position_filter", make_position_filter_table(), &C::position_filter);
+  t.section("fault_accommodation", make_fault_accommodation_table(), &C::fault_accommodation);
 }
 
 config::Table<TaskConfig> make_task_table() {
@@ -205,6 +227,9 @@ void add_driving_aid_options(cli::CommandLine& cmd, DrivingAidOptions& options) 
              "the policy's position filter, time constant in s (0: off; docs/usage.md, "
              "\"Position filter\")");
   cmd.check("position-filter", CLI::Range(0.0, PositionFilterSettings::kMaxTimeConstantS));
+  cmd.option("fault-accommodation", &options.fault_accommodation,
+             "the policy's thruster fault accommodation, true or false (docs/usage.md, \"Fault "
+             "accommodation\")");
 }
 
 void read_task_config(config::Section s, TaskConfig& c) {

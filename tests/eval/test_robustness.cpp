@@ -547,6 +547,32 @@ TEST(RobustnessRun, ThePositionFilterCalmsTheCommandsUnderSensorNoise) {
   EXPECT_LT(mean_of(with, energy), 0.9 * mean_of(without, energy));
 }
 
+// The fault accommodation (task.fault_accommodation) stops commanding a dead thruster and gives
+// its share to the others: the committed policy with its front lateral or front vertical
+// thruster dead holds closer and spends less with it than without it.
+TEST(RobustnessRun, FaultAccommodationHoldsCloserWithADeadThruster) {
+  EvaluationConfig c = config();
+  task::apply_vehicle(nessie().facts(), c.task);
+  for (const char* group : {"t4_0pct", "t6_0pct"}) {
+    const std::vector<EvaluationEpisode> episodes =
+        of_group(robustness_episodes(c, 6, 4, 1), group);
+    ASSERT_EQ(episodes.size(), 4u);
+    const auto rows = [&](bool accommodate) {
+      EvaluationConfig with = c;
+      with.task.fault_accommodation.enabled = accommodate;
+      return committed_policy_rows(with, episodes);
+    };
+    const auto hold = [](const SummaryRow& r) { return r.mean_error_after_reach_m; };
+    const auto energy = [](const SummaryRow& r) { return r.thrust_energy; };
+    const std::vector<SummaryRow> without = rows(false), with = rows(true);
+    std::cout << group << ": hold error " << mean_of(without, hold) << " m without the fault "
+              << "accommodation, " << mean_of(with, hold) << " m with it; energy "
+              << mean_of(without, energy) << ", " << mean_of(with, energy) << "\n";
+    EXPECT_LT(mean_of(with, hold), 0.9 * mean_of(without, hold)) << group;
+    EXPECT_LT(mean_of(with, energy), 0.8 * mean_of(without, energy)) << group;
+  }
+}
+
 TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {
   TempDir dir;
   agent::PidController pid(nessie());

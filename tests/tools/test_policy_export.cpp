@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -23,6 +24,8 @@
 #include "common/nn/random.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/process.hpp"
+#include "common/task/fault_accommodation.hpp"
+#include "sim/dynamics.hpp"
 #include "tools/export/c_header.hpp"
 #include "tools/export/policy_export.hpp"
 
@@ -373,6 +376,62 @@ TEST(PolicyExportC, FiltersThePositionAsAuvrlDoes) {
             0)
       << log;
   EXPECT_LE(max_abs_difference(read_raw<double>(dir.path("estimates.f64")), expected), 1e-9);
+}
+
+// The header's fault accommodation finds the dead thruster when auvrl's does
+// (task::ThrusterFaultAccommodation) and rewrites the actions as it does, step by step, on a
+// vehicle whose front vertical thruster is dead: the states are the simulator's, the actions
+// a random walk.
+TEST(PolicyExportC, AccommodatesADeadThrusterAsAuvrlDoes) {
+  const std::string cc = find_program("cc");
+  if (cc.empty()) GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
+  TempDir dir;
+  const std::string exe = build_driver(dir, kPolicy, cc);
+  ASSERT_FALSE(exe.empty());
+  task::TaskConfig c;
+  c.layout = task::StateLayout::kExtendedThrust;
+  task::apply_vehicle(nessie().facts(), c);
+  task::ThrusterFaultAccommodation faults(c);
+  sim::ResetSettings reset;
+  reset.eta << 0, 0, 5, 0, 0, 0;
+  reset.thruster_efficiency = sim::ThrusterVector::Ones(6);
+  reset.thruster_efficiency[5] = 0.0;
+  sim::VehicleState vehicle = sim::make_state(nessie(), reset);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> walk(-0.15f, 0.15f);
+  task::ActionVector previous = task::ActionVector::Zero(6), wanted = previous;
+  std::vector<float> records, expected;
+  for (int t = 0; t < 300; ++t) {
+    const sim::Measurement m = sim::measure(nessie(), vehicle);
+    task::Observation obs;
+    obs.position_ned_m = m.eta.head<3>();
+    obs.euler_rpy_rad = m.eta.tail<3>();
+    obs.velocity_body_mps = m.nu.head<3>();
+    obs.angular_rate_body_rad_s = m.nu.tail<3>();
+    task::StateVector state;
+    task::build_state(
+        c, obs, Eigen::Vector3d(0, 0, 5), previous, state,
+        std::vector<double>(m.thrust_realised_n.data(), m.thrust_realised_n.data() + 6));
+    for (int i = 0; i < 6; ++i) wanted[i] = std::clamp(wanted[i] + walk(rng), -1.0f, 1.0f);
+    records.insert(records.end(), state.data(), state.data() + state.size());
+    records.insert(records.end(), wanted.data(), wanted.data() + 6);
+    task::ActionVector action = wanted;
+    faults.apply(state, action);
+    expected.insert(expected.end(), action.data(), action.data() + 6);
+    sim::step(nessie(), vehicle, (action.cast<double>() * c.max_thrust_n).eval());
+    previous = action;
+  }
+  ASSERT_TRUE(faults.dead(5));
+  write_raw(dir.path("records.f32"), records);
+  std::string log;
+  ASSERT_EQ(run({exe, "faults", dir.path("records.f32"), dir.path("actions.f32")},
+                dir.path("run.log"), &log),
+            0)
+      << log;
+  const std::vector<float> actions = read_raw<float>(dir.path("actions.f32"));
+  ASSERT_EQ(actions.size(), expected.size());
+  EXPECT_LE(max_abs_difference(actions, expected), 1e-6);
+  EXPECT_EQ(actions[actions.size() - 1], 0.0f);  // T6, dead, gets nothing
 }
 
 TEST(PolicyExportC, DocumentsLayoutScalesAndThrusters) {

@@ -16,8 +16,7 @@ namespace auvrl::tuning::test {
 inline task::TaskConfig fast_task() {
   task::TaskConfig t;
   t.layout = task::StateLayout::kExtendedThrust;
-  t.num_thrusters = 6;
-  t.max_thrust_n = test_support::nessie().thruster_dynamics.max_thrust_n;
+  task::apply_vehicle(test_support::nessie().facts(), t);
   return t;
 }
 

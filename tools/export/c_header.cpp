@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+
+#include "common/task/fault_accommodation.hpp"
 
 namespace auvrl::tools {
 
@@ -48,6 +51,16 @@ double position_filter_gain(const task::TaskConfig& task) {
   return task::PositionFilter(task.position_filter, task.control_step_s).gain();
 }
 
+/// The task's fault accommodation when the policy has one (on, and a layout with the realised
+/// thrust), as auvrl's policy controller builds it.
+std::optional<task::ThrusterFaultAccommodation> fault_accommodation(const ExportedPolicy& policy) {
+  const task::TaskConfig& task = policy.task;
+  if (!task.fault_accommodation.enabled || task.layout != task::StateLayout::kExtendedThrust) {
+    return std::nullopt;
+  }
+  return task::ThrusterFaultAccommodation(task);
+}
+
 /// The header's opening comment: what it holds and how a vehicle uses it.
 std::string opening_comment(const ExportedPolicy& policy) {
   const std::string use =
@@ -64,12 +77,14 @@ std::string opening_comment(const ExportedPolicy& policy) {
       "  float previous[AUVRL_POLICY_NUM_ACTIONS];  (zeros at the start, then the last action)\n"
       "  double offset_ned_m[3];  (zeros at the start of a mission; kept across way-points)\n"
       "  auvrl_position_filter filter;  (zeros at the start of a mission)\n"
+      "  auvrl_fault_accommodation faults;  (zeros at the start of a mission)\n"
       "  double moved_goal_ned_m[3];\n"
       "  float state[AUVRL_POLICY_STATE_DIM], action[AUVRL_POLICY_NUM_ACTIONS];\n"
       "  auvrl_policy_filter_position(&filter, &nav);\n"
       "  auvrl_policy_integrate_goal(offset_ned_m, &nav, goal_ned_m, moved_goal_ned_m);\n"
       "  auvrl_policy_build_state(&nav, moved_goal_ned_m, previous, state);\n"
       "  auvrl_policy_act(state, action);\n"
+      "  auvrl_policy_accommodate_faults(&faults, state, action);\n"
       "  thrust command of thruster i (N) = action[i] * AUVRL_POLICY_MAX_THRUST_N;\n"
       "  copy action into previous.\n";
   return "/* auvrl_policy.h: a trained auvrl policy.\n *\n" + comment_lines(use) + " */\n";
@@ -100,6 +115,9 @@ std::string macros(const ExportedPolicy& policy) {
       "/* Position filter (auvrl_policy_filter_position): the share of the distance to the\n"
       " * position fix closed each control step (0: off). */\n"
       "#define AUVRL_POLICY_POSITION_FILTER_GAIN {}\n"
+      "/* Fault accommodation (auvrl_policy_accommodate_faults): 1 on, 0 off (or a layout\n"
+      " * without the realised thrust). */\n"
+      "#define AUVRL_POLICY_FAULT_ACCOMMODATION {}\n"
       "/* Scales: a state entry is the quantity divided by its scale. */\n"
       "#define AUVRL_POLICY_SCALE_POSITION_M {}\n"
       "#define AUVRL_POLICY_SCALE_LINEAR_VELOCITY_MPS {}\n"
@@ -112,9 +130,9 @@ std::string macros(const ExportedPolicy& policy) {
       c_double_literal(policy.task.integral.gain_per_s),
       c_double_literal(policy.task.integral.radius_m),
       c_double_literal(policy.task.integral.max_offset_m),
-      c_double_literal(position_filter_gain(policy.task)), c_double_literal(k.position_m),
-      c_double_literal(k.linear_velocity_mps), c_double_literal(k.angular_rate_rad_s),
-      c_double_literal(k.depth_m));
+      c_double_literal(position_filter_gain(policy.task)), fault_accommodation(policy) ? 1 : 0,
+      c_double_literal(k.position_m), c_double_literal(k.linear_velocity_mps),
+      c_double_literal(k.angular_rate_rad_s), c_double_literal(k.depth_m));
   for (int i = 0; i < policy.vehicle.num_thrusters(); ++i) {
     out += fmt::format("#define AUVRL_POLICY_THRUSTER_{}_NAME \"{}\"\n", i,
                        policy.vehicle.thruster_names[static_cast<std::size_t>(i)]);
@@ -351,6 +369,140 @@ std::string filter_position_function() {
          "}\n";
 }
 
+/// The fault accommodation's constants: the replica, the estimate, the wrench matrix B'B.
+std::string fault_constants(const task::ThrusterFaultAccommodation& fa,
+                            const task::TaskConfig& task) {
+  const ThrusterDynamics& td = task.thruster_dynamics;
+  std::string out = fmt::format(
+      "#define AUVRL_POLICY_FAULT_DEAD_BELOW_ {}\n"
+      "#define AUVRL_POLICY_FAULT_ESTIMATE_GAIN_ {}\n"
+      "#define AUVRL_POLICY_FAULT_MIN_SQUARED_N2_ {}\n"
+      "#define AUVRL_POLICY_FAULT_DAMPING_ {}\n"
+      "#define AUVRL_POLICY_THRUST_DELAY_ {}\n"
+      "#define AUVRL_POLICY_THRUST_LAG_BLEND_ {}\n"
+      "#define AUVRL_POLICY_THRUST_SLEW_ {}\n"
+      "#define AUVRL_POLICY_THRUST_SLEW_STEP_N_ {}\n"
+      "static const double auvrl_policy_wrench_gram_[AUVRL_POLICY_NUM_THRUSTERS]"
+      "[AUVRL_POLICY_NUM_THRUSTERS] = {{\n",
+      c_double_literal(task.fault_accommodation.dead_below), c_double_literal(fa.estimate_gain()),
+      c_double_literal(task::ThrusterFaultAccommodation::kMinReplicaThrustN *
+                       task::ThrusterFaultAccommodation::kMinReplicaThrustN),
+      c_double_literal(fa.damping()), td.delay_enabled ? 1 : 0, c_double_literal(fa.lag_blend()),
+      td.slew_enabled ? 1 : 0, c_double_literal(fa.slew_step_n()));
+  const Eigen::MatrixXd& gram = fa.wrench_gram();
+  for (Eigen::Index i = 0; i < gram.rows(); ++i) {
+    out += "    {";
+    for (Eigen::Index j = 0; j < gram.cols(); ++j) {
+      out += (j ? ", " : "") + c_double_literal(gram(i, j));
+    }
+    out += "},\n";
+  }
+  return out + "};\n\n";
+}
+
+/// The estimate step of auvrl_policy_accommodate_faults (task::ThrusterFaultAccommodation's).
+std::string fault_estimate_lines() {
+  return "  for (i = 0; i < n; ++i) {\n"
+         "    const double max = AUVRL_POLICY_MAX_THRUST_N;\n"
+         "    double command_n = (double)state[16 + i] * max, target_n, change_n, f;\n"
+         "    const double realised_n = (double)state[17 + n + i] * max;\n"
+         "    command_n = command_n < -max ? -max : command_n > max ? max : command_n;\n"
+         "    target_n = AUVRL_POLICY_THRUST_DELAY_ ? fa->replica_delayed_n[i] : command_n;\n"
+         "    change_n = AUVRL_POLICY_THRUST_LAG_BLEND_ * (target_n - fa->replica_n[i]);\n"
+         "    if (AUVRL_POLICY_THRUST_SLEW_) {\n"
+         "      const double s = AUVRL_POLICY_THRUST_SLEW_STEP_N_;\n"
+         "      change_n = change_n < -s ? -s : change_n > s ? s : change_n;\n"
+         "    }\n"
+         "    fa->replica_n[i] += change_n;\n"
+         "    fa->replica_delayed_n[i] = command_n;\n"
+         "    f = fa->replica_n[i];\n"
+         "    fa->moment_realised_replica[i] +=\n"
+         "        AUVRL_POLICY_FAULT_ESTIMATE_GAIN_ * (realised_n * f - "
+         "fa->moment_realised_replica[i]);\n"
+         "    fa->moment_replica_squared[i] +=\n"
+         "        AUVRL_POLICY_FAULT_ESTIMATE_GAIN_ * (f * f - fa->moment_replica_squared[i]);\n"
+         "    if (fa->moment_replica_squared[i] >= AUVRL_POLICY_FAULT_MIN_SQUARED_N2_) {\n"
+         "      double e = fa->moment_realised_replica[i] / fa->moment_replica_squared[i];\n"
+         "      e = e < 0.0 ? 0.0 : e > 1.0 ? 1.0 : e;\n"
+         "      if (e < AUVRL_POLICY_FAULT_DEAD_BELOW_) fa->dead[i] = 1;\n"
+         "    }\n"
+         "    if (fa->dead[i]) any = 1;\n"
+         "  }\n";
+}
+
+/// The redistribution step: the damped least-squares system solved by Cholesky.
+std::string fault_redistribution_lines() {
+  return "  if (!any) return;\n"
+         "  for (i = 0; i < n; ++i) {\n"
+         "    const double keep_i = fa->dead[i] ? 0.0 : 1.0;\n"
+         "    double wrench = 0.0;\n"
+         "    for (j = 0; j < n; ++j) {\n"
+         "      const double keep_j = fa->dead[j] ? 0.0 : 1.0;\n"
+         "      a[i][j] = keep_i * auvrl_policy_wrench_gram_[i][j] * keep_j;\n"
+         "      wrench += auvrl_policy_wrench_gram_[i][j] * (double)action[j];\n"
+         "    }\n"
+         "    a[i][i] += AUVRL_POLICY_FAULT_DAMPING_;\n"
+         "    x[i] = keep_i * wrench + AUVRL_POLICY_FAULT_DAMPING_ * keep_i * (double)action[i];\n"
+         "  }\n"
+         "  /* a = L L^T in place (lower triangle), then L y = x, L^T u = y. */\n"
+         "  for (j = 0; j < n; ++j) {\n"
+         "    for (k = 0; k < j; ++k) a[j][j] -= a[j][k] * a[j][k];\n"
+         "    a[j][j] = sqrt(a[j][j]);\n"
+         "    for (i = j + 1; i < n; ++i) {\n"
+         "      for (k = 0; k < j; ++k) a[i][j] -= a[i][k] * a[j][k];\n"
+         "      a[i][j] /= a[j][j];\n"
+         "    }\n"
+         "  }\n"
+         "  for (i = 0; i < n; ++i) {\n"
+         "    for (k = 0; k < i; ++k) x[i] -= a[i][k] * x[k];\n"
+         "    x[i] /= a[i][i];\n"
+         "  }\n"
+         "  for (i = n - 1; i >= 0; --i) {\n"
+         "    for (k = i + 1; k < n; ++k) x[i] -= a[k][i] * x[k];\n"
+         "    x[i] /= a[i][i];\n"
+         "  }\n"
+         "  for (i = 0; i < n; ++i) action[i] = (float)(x[i] < -1.0 ? -1.0 : x[i] > 1.0 ? 1.0 : "
+         "x[i]);\n";
+}
+
+/// auvrl_fault_accommodation and auvrl_policy_accommodate_faults:
+/// task::ThrusterFaultAccommodation in C (a no-op where the policy has none).
+std::string accommodate_faults_function(const ExportedPolicy& policy) {
+  const std::optional<task::ThrusterFaultAccommodation> fa = fault_accommodation(policy);
+  std::string out =
+      "/* Thruster fault accommodation, as auvrl's policy controller runs it\n"
+      " * (task::ThrusterFaultAccommodation, docs/usage.md \"Fault accommodation\"): once per\n"
+      " * control step, after auvrl_policy_act, on the state the policy was given and its\n"
+      " * action, rewritten in place. A replica of a healthy thruster estimates each thruster's\n"
+      " * efficiency from the state's realised thrust; one below the dead threshold is dead until\n"
+      " * the struct is zeroed again: it gets 0 and the others take up its share of the body\n"
+      " * wrench in damped least squares. With every thruster healthy the action is untouched.\n"
+      " * Zero the struct at the start of a mission. */\n"
+      "typedef struct auvrl_fault_accommodation {\n"
+      "  double replica_delayed_n[AUVRL_POLICY_NUM_THRUSTERS]; /* a healthy thruster's command */\n"
+      "  double replica_n[AUVRL_POLICY_NUM_THRUSTERS];         /* and its thrust, N */\n"
+      "  double moment_realised_replica[AUVRL_POLICY_NUM_THRUSTERS];\n"
+      "  double moment_replica_squared[AUVRL_POLICY_NUM_THRUSTERS];\n"
+      "  int dead[AUVRL_POLICY_NUM_THRUSTERS]; /* 1: found dead */\n"
+      "} auvrl_fault_accommodation;\n\n";
+  if (!fa) {
+    return out +
+           "static inline void auvrl_policy_accommodate_faults(auvrl_fault_accommodation *fa,\n"
+           "                                                   const float *state, float *action) "
+           "{\n"
+           "  (void)fa;\n  (void)state;\n  (void)action;\n}\n";
+  }
+  return out + fault_constants(*fa, policy.task) +
+         "static inline void auvrl_policy_accommodate_faults(auvrl_fault_accommodation *fa,\n"
+         "                                                   const float *state, float *action) "
+         "{\n"
+         "  const int n = AUVRL_POLICY_NUM_THRUSTERS;\n"
+         "  double a[AUVRL_POLICY_NUM_THRUSTERS][AUVRL_POLICY_NUM_THRUSTERS];\n"
+         "  double x[AUVRL_POLICY_NUM_THRUSTERS];\n"
+         "  int i, j, k, any = 0;\n" +
+         fault_estimate_lines() + fault_redistribution_lines() + "}\n";
+}
+
 }  // namespace
 
 std::string policy_c_header(const ExportedPolicy& policy) {
@@ -358,7 +510,8 @@ std::string policy_c_header(const ExportedPolicy& policy) {
          "\n#ifndef AUVRL_POLICY_H\n#define AUVRL_POLICY_H\n\n#include <math.h>\n\n" +
          macros(policy) + "\n" + params_array(policy) + "\n" + act_function(policy) + "\n" +
          nav_struct(policy) + "\n" + filter_position_function() + "\n" + integrate_goal_function() +
-         "\n" + build_state_function(policy) + "\n#endif /* AUVRL_POLICY_H */\n";
+         "\n" + build_state_function(policy) + "\n" + accommodate_faults_function(policy) +
+         "\n#endif /* AUVRL_POLICY_H */\n";
 }
 
 }  // namespace auvrl::tools

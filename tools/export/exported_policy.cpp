@@ -202,6 +202,19 @@ std::string describe_policy(const ExportedPolicy& policy) {
                    "  the C export's auvrl_policy_filter_position).\n",
                    filter.time_constant_s)
              : std::string("Position filter: off (the state takes the measured position).\n");
+  const task::FaultAccommodationSettings& faults = policy.task.fault_accommodation;
+  if (!faults.enabled) {
+    out += "Fault accommodation: off (the actions go to the thrusters as they are).\n";
+  } else if (policy.task.layout != task::StateLayout::kExtendedThrust) {
+    out += "Fault accommodation: none (this layout does not carry the realised thrust).\n";
+  } else {
+    out += fmt::format(
+        "Fault accommodation: a thruster whose realised thrust falls below {} of a healthy\n"
+        "  thruster's (estimated over {} s) is dead: its action becomes 0 and the others take up\n"
+        "  its share of the body wrench (damping {}; auvrl's task::ThrusterFaultAccommodation;\n"
+        "  the C export's auvrl_policy_accommodate_faults).\n",
+        faults.dead_below, faults.estimate_time_constant_s, faults.damping);
+  }
   return out + describe_state_text(policy) + describe_action_text(policy);
 }
 

@@ -15,6 +15,10 @@
  *                                      yaw, body velocity), one control step each, from a
  *                                      zeroed filter -> float64 estimated positions
  *                                      (auvrl_policy_filter_position)
+ *   policy_driver faults RECORDS OUT   float32 records of a state and an action
+ *                                      (AUVRL_POLICY_STATE_DIM + AUVRL_POLICY_NUM_ACTIONS), one
+ *                                      control step each, from a zeroed struct -> float32
+ *                                      actions (auvrl_policy_accommodate_faults)
  *   policy_driver params PARAMS        auvrl_policy_params as float32
  */
 #include <stdio.h>
@@ -83,6 +87,18 @@ static int filter_position(FILE *in, FILE *out) {
   return 0;
 }
 
+static int accommodate_faults(FILE *in, FILE *out) {
+  float r[AUVRL_POLICY_STATE_DIM + AUVRL_POLICY_NUM_ACTIONS];
+  auvrl_fault_accommodation faults;
+  memset(&faults, 0, sizeof faults);
+  while (fread(r, sizeof r, 1, in) == 1) {
+    float *action = r + AUVRL_POLICY_STATE_DIM;
+    auvrl_policy_accommodate_faults(&faults, r, action);
+    if (fwrite(action, sizeof(float) * AUVRL_POLICY_NUM_ACTIONS, 1, out) != 1) return 1;
+  }
+  return 0;
+}
+
 int main(int argc, char **argv) {
   FILE *in = NULL, *out = NULL;
   int status = 2;
@@ -94,7 +110,8 @@ int main(int argc, char **argv) {
   }
   if (argc != 4) {
     fprintf(stderr,
-            "usage: policy_driver act|state|integrate|filter IN OUT, or policy_driver params OUT\n");
+            "usage: policy_driver act|state|integrate|filter|faults IN OUT, or policy_driver "
+            "params OUT\n");
     return 2;
   }
   in = fopen(argv[2], "rb");
@@ -104,6 +121,7 @@ int main(int argc, char **argv) {
     if (strcmp(argv[1], "state") == 0) status = build_state(in, out);
     if (strcmp(argv[1], "integrate") == 0) status = integrate(in, out);
     if (strcmp(argv[1], "filter") == 0) status = filter_position(in, out);
+    if (strcmp(argv[1], "faults") == 0) status = accommodate_faults(in, out);
   } else {
     status = 1;
   }

@@ -1,0 +1,196 @@
+// Thruster fault accommodation (task::ThrusterFaultAccommodation) against the real thruster
+// model of sim::step: a healthy vehicle's commands pass untouched, a dead thruster is found and
+// no longer commanded while the others take up its wrench, a weak one is measured and kept, a
+// slower thruster than the model's is not taken for a dead one, and what it cannot serve is
+// refused by name.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/task/fault_accommodation.hpp"
+#include "sim/dynamics.hpp"
+#include "sim/vehicle_model.hpp"
+
+namespace auvrl::task {
+namespace {
+
+const sim::VehicleModel& nessie() {
+  static const sim::VehicleModel model =
+      sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml");
+  return model;
+}
+
+TaskConfig fast_layout() {
+  TaskConfig task;
+  task.layout = StateLayout::kExtendedThrust;
+  apply_vehicle(nessie().facts(), task);
+  return task;
+}
+
+/// A vehicle driven by smoothly wandering commands (a random walk in [-1, 1]), each step's
+/// commands passed through the accommodation as a driving policy's would be.
+class Drive {
+ public:
+  Drive(const sim::VehicleModel& model, const TaskConfig& task, std::vector<double> efficiency)
+      : model_(model), task_(task), accommodation_(task), rng_(7) {
+    sim::ResetSettings reset;
+    reset.eta << 0, 0, 5, 0, 0, 0;
+    reset.thruster_efficiency = Eigen::Map<const Eigen::VectorXd>(efficiency.data(), 6);
+    state_ = sim::make_state(model_, reset);
+    wanted_ = previous_ = ActionVector::Zero(6);
+  }
+  /// One control step; returns the commands the vehicle got.
+  const ActionVector& step() {
+    std::uniform_real_distribution<float> walk(-0.15f, 0.15f);
+    for (int i = 0; i < 6; ++i) wanted_[i] = std::clamp(wanted_[i] + walk(rng_), -1.0f, 1.0f);
+    const sim::Measurement m = sim::measure(model_, state_);
+    Observation obs;
+    obs.position_ned_m = m.eta.head<3>();
+    obs.euler_rpy_rad = m.eta.tail<3>();
+    obs.velocity_body_mps = m.nu.head<3>();
+    obs.angular_rate_body_rad_s = m.nu.tail<3>();
+    StateVector state;
+    build_state(task_, obs, Eigen::Vector3d(0, 0, 5), previous_, state,
+                std::vector<double>(m.thrust_realised_n.data(), m.thrust_realised_n.data() + 6));
+    sent_ = wanted_;
+    accommodation_.apply(state, sent_);
+    sim::step(model_, state_, (sent_.cast<double>() * task_.max_thrust_n).eval());
+    state_.eta.head<3>() << 0, 0, 5;  // keep the vehicle in place: only the thrusters matter
+    state_.nu.setZero();
+    previous_ = sent_;
+    return sent_;
+  }
+  const ActionVector& wanted() const { return wanted_; }
+  const ThrusterFaultAccommodation& accommodation() const { return accommodation_; }
+
+ private:
+  const sim::VehicleModel& model_;
+  TaskConfig task_;
+  ThrusterFaultAccommodation accommodation_;
+  sim::VehicleState state_;
+  std::mt19937 rng_;
+  ActionVector wanted_, previous_, sent_;
+};
+
+TEST(FaultAccommodation, LeavesEveryHealthyThrusterAlone) {
+  Drive drive(nessie(), fast_layout(), std::vector<double>(6, 1.0));
+  for (int t = 0; t < 600; ++t) {
+    ASSERT_EQ(drive.step(), drive.wanted()) << t;
+  }
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_FALSE(drive.accommodation().dead(i)) << i;
+    EXPECT_NEAR(drive.accommodation().efficiency_estimate()[i], 1.0, 1e-6) << i;
+  }
+}
+
+// Thrusters twice as slow as the model says (the robustness suite's 0.6 s lag): the replica is
+// wrong in every transient, and still no thruster counts as dead.
+TEST(FaultAccommodation, TakesNoSlowThrusterForADeadOne) {
+  sim::VehicleModel slow = nessie();
+  slow.thruster_dynamics.lag_time_constant_s = 0.6;
+  slow.thruster_dynamics.slew_rate_n_per_s *= 0.5;
+  Drive drive(slow, fast_layout(), std::vector<double>(6, 1.0));
+  double lowest = 1.0;
+  for (int t = 0; t < 1200; ++t) {
+    ASSERT_EQ(drive.step(), drive.wanted()) << t;
+    lowest = std::min(lowest, drive.accommodation().efficiency_estimate().minCoeff());
+  }
+  std::cout << "lowest efficiency estimate with thrusters twice as slow: " << lowest << "\n";
+  EXPECT_GT(lowest, 0.3);
+}
+
+// Each thruster dead in turn: found within 4 s of commands that wander from rest, never
+// commanded again, and the wrench the policy asked for is rebuilt in part by the others (the
+// damping keeps them near the policy's own commands: a dead vertical thruster leaves heave and
+// pitch to one, which cannot give both).
+TEST(FaultAccommodation, FindsADeadThrusterAndGivesItsWrenchToTheOthers) {
+  const TaskConfig task = fast_layout();
+  Eigen::MatrixXd wrench(6, 6);
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < 6; ++k) wrench(k, i) = task.thruster_wrench[i][k];
+  }
+  for (int dead = 0; dead < 6; ++dead) {
+    std::vector<double> efficiency(6, 1.0);
+    efficiency[static_cast<std::size_t>(dead)] = 0.0;
+    Drive drive(nessie(), task, efficiency);
+    int found = -1;
+    for (int t = 0; t < 100 && found < 0; ++t) {
+      drive.step();
+      if (drive.accommodation().dead(dead)) found = t;
+    }
+    ASSERT_GE(found, 0) << dead;
+    EXPECT_LE(found, 40) << dead;
+    double lost_unaided = 0.0, lost_accommodated = 0.0;
+    for (int t = 0; t < 200; ++t) {
+      const ActionVector sent = drive.step();
+      ASSERT_EQ(sent[dead], 0.0f) << dead << " " << t;
+      ActionVector unaided = drive.wanted();
+      unaided[dead] = 0.0f;  // what the dead thruster leaves of the policy's commands
+      const Eigen::VectorXd wanted_wrench = wrench * drive.wanted().cast<double>();
+      lost_unaided += (wrench * unaided.cast<double>() - wanted_wrench).norm();
+      lost_accommodated += (wrench * sent.cast<double>() - wanted_wrench).norm();
+    }
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(drive.accommodation().dead(i), i == dead) << dead;
+    std::cout << "T" << dead + 1 << " dead: found after " << found
+              << " steps; wrench lost per step " << lost_unaided / 200 << " unaided, "
+              << lost_accommodated / 200 << " accommodated\n";
+    EXPECT_LT(lost_accommodated, 0.95 * lost_unaided) << dead;
+  }
+}
+
+TEST(FaultAccommodation, MeasuresAWeakThrusterAndKeepsItsCommands) {
+  Drive drive(nessie(), fast_layout(), {0.1, 1, 1, 1, 1, 1});  // T1 at 10 %: the paper's fault
+  for (int t = 0; t < 300; ++t) ASSERT_EQ(drive.step(), drive.wanted()) << t;
+  EXPECT_NEAR(drive.accommodation().efficiency_estimate()[0], 0.1, 1e-6);
+  EXPECT_FALSE(drive.accommodation().dead(0));
+}
+
+TEST(FaultAccommodation, ResetForgetsTheDeadThruster) {
+  Drive drive(nessie(), fast_layout(), {1, 1, 0, 1, 1, 1});
+  for (int t = 0; t < 50; ++t) drive.step();
+  ThrusterFaultAccommodation copy = drive.accommodation();
+  ASSERT_TRUE(copy.dead(2));
+  copy.reset();
+  EXPECT_FALSE(copy.dead(2));
+  EXPECT_EQ(copy.efficiency_estimate(), Eigen::VectorXd::Ones(6));
+}
+
+TEST(FaultAccommodation, RefusesWhatItCannotServe) {
+  TaskConfig task = fast_layout();
+  const auto message = [](const TaskConfig& t) {
+    try {
+      ThrusterFaultAccommodation a(t);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  TaskConfig extended = task;
+  extended.layout = StateLayout::kExtended;
+  EXPECT_NE(message(extended).find("extended layout does not carry the realised thrust"),
+            std::string::npos);
+  TaskConfig unsized = task;
+  unsized.thruster_wrench.clear();
+  EXPECT_NE(message(unsized).find("apply_vehicle"), std::string::npos);
+  TaskConfig off = task;
+  off.fault_accommodation.enabled = false;
+  EXPECT_NE(message(off).find("off"), std::string::npos);
+  TaskConfig bad = task;
+  bad.fault_accommodation.dead_below = 1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  try {
+    bad.validate();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("task.fault_accommodation.dead_below"), std::string::npos);
+  }
+  bad = task;
+  bad.fault_accommodation.damping = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  EXPECT_EQ(message(task), "accepted");
+}
+
+}  // namespace
+}  // namespace auvrl::task
