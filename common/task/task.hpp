@@ -97,8 +97,8 @@ struct PositionFilterSettings {
   bool enabled() const { return time_constant_s > 0.0; }
 };
 
-/// Thruster fault accommodation for a driving policy (evaluation, fine-tuning, missions,
-/// deployment; never the actors' training episodes; task::ThrusterFaultAccommodation): each
+/// Thruster fault accommodation for a driving policy (evaluation, missions, deployment; not
+/// the fine-tuning's own episodes nor the actors'; task::ThrusterFaultAccommodation): each
 /// thruster's efficiency is estimated from its realised thrust against a healthy thruster's
 /// response to the same commands; once it falls below dead_below the thruster is dead until
 /// the next reset: it is no longer commanded, and its share of the policy's body wrench goes

@@ -112,8 +112,8 @@ config::Table<PositionFilterSettings> make_position_filter_table() {
 config::Table<FaultAccommodationSettings> make_fault_accommodation_table() {
   using F = FaultAccommodationSettings;
   config::Table<F> t("fault_accommodation",
-                     "a driving policy's answer to a dead thruster (evaluation, fine-tuning, "
-                     "missions, deployment; not the actors' training episodes; extended_thrust "
+                     "a driving policy's answer to a dead thruster (evaluation, missions, "
+                     "deployment; not the fine-tuning's episodes nor the actors'; extended_thrust "
                      "layout): detected from its realised thrust, no longer commanded, its share "
                      "of the wrench given to the others");
   t.field("enabled", &F::enabled, "", "accommodate dead thrusters when a policy drives");

@@ -5,13 +5,14 @@
 // refused by name.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "agent/vehicle_link.hpp"
 #include "common/task/fault_accommodation.hpp"
-#include "sim/dynamics.hpp"
 #include "sim/vehicle_model.hpp"
 
 namespace auvrl::task {
@@ -30,36 +31,30 @@ TaskConfig fast_layout() {
   return task;
 }
 
-/// A vehicle driven by smoothly wandering commands (a random walk in [-1, 1]), each step's
-/// commands passed through the accommodation as a driving policy's would be.
+/// A vehicle (the simulator in this process) driven by smoothly wandering commands (a random
+/// walk in [-1, 1]), each step's commands passed through the accommodation as a driving
+/// policy's would be.
 class Drive {
  public:
   Drive(const sim::VehicleModel& model, const TaskConfig& task, std::vector<double> efficiency)
-      : model_(model), task_(task), accommodation_(task), rng_(7) {
-    sim::ResetSettings reset;
-    reset.eta << 0, 0, 5, 0, 0, 0;
-    reset.thruster_efficiency = Eigen::Map<const Eigen::VectorXd>(efficiency.data(), 6);
-    state_ = sim::make_state(model_, reset);
+      : task_(task), accommodation_(task), link_(agent::make_in_process_link(model)), rng_(7) {
+    agent::EpisodeStart start;
+    start.thruster_efficiency = std::move(efficiency);
+    report_ = *link_->reset(start);
     wanted_ = previous_ = ActionVector::Zero(6);
   }
   /// One control step; returns the commands the vehicle got.
   const ActionVector& step() {
     std::uniform_real_distribution<float> walk(-0.15f, 0.15f);
     for (int i = 0; i < 6; ++i) wanted_[i] = std::clamp(wanted_[i] + walk(rng_), -1.0f, 1.0f);
-    const sim::Measurement m = sim::measure(model_, state_);
-    Observation obs;
-    obs.position_ned_m = m.eta.head<3>();
-    obs.euler_rpy_rad = m.eta.tail<3>();
-    obs.velocity_body_mps = m.nu.head<3>();
-    obs.angular_rate_body_rad_s = m.nu.tail<3>();
     StateVector state;
-    build_state(task_, obs, Eigen::Vector3d(0, 0, 5), previous_, state,
-                std::vector<double>(m.thrust_realised_n.data(), m.thrust_realised_n.data() + 6));
+    build_state(task_, report_.observation, Eigen::Vector3d(0, 0, 5), previous_, state,
+                report_.thrust_realised_n);
     sent_ = wanted_;
     accommodation_.apply(state, sent_);
-    sim::step(model_, state_, (sent_.cast<double>() * task_.max_thrust_n).eval());
-    state_.eta.head<3>() << 0, 0, 5;  // keep the vehicle in place: only the thrusters matter
-    state_.nu.setZero();
+    std::vector<double> thrust_n(6);
+    for (int i = 0; i < 6; ++i) thrust_n[i] = sent_[i] * task_.max_thrust_n;
+    report_ = *link_->step(thrust_n);
     previous_ = sent_;
     return sent_;
   }
@@ -67,10 +62,10 @@ class Drive {
   const ThrusterFaultAccommodation& accommodation() const { return accommodation_; }
 
  private:
-  const sim::VehicleModel& model_;
   TaskConfig task_;
   ThrusterFaultAccommodation accommodation_;
-  sim::VehicleState state_;
+  std::unique_ptr<agent::VehicleLink> link_;
+  agent::VehicleReport report_;
   std::mt19937 rng_;
   ActionVector wanted_, previous_, sent_;
 };

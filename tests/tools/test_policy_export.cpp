@@ -19,13 +19,13 @@
 #include <string>
 #include <vector>
 
+#include "agent/vehicle_link.hpp"
 #include "agent_test_util.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/random.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/process.hpp"
 #include "common/task/fault_accommodation.hpp"
-#include "sim/dynamics.hpp"
 #include "tools/export/c_header.hpp"
 #include "tools/export/policy_export.hpp"
 
@@ -392,33 +392,27 @@ TEST(PolicyExportC, AccommodatesADeadThrusterAsAuvrlDoes) {
   c.layout = task::StateLayout::kExtendedThrust;
   task::apply_vehicle(nessie().facts(), c);
   task::ThrusterFaultAccommodation faults(c);
-  sim::ResetSettings reset;
-  reset.eta << 0, 0, 5, 0, 0, 0;
-  reset.thruster_efficiency = sim::ThrusterVector::Ones(6);
-  reset.thruster_efficiency[5] = 0.0;
-  sim::VehicleState vehicle = sim::make_state(nessie(), reset);
+  auto link = agent::make_in_process_link(nessie());
+  agent::EpisodeStart start;
+  start.thruster_efficiency = {1, 1, 1, 1, 1, 0};
+  agent::VehicleReport report = *link->reset(start);
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> walk(-0.15f, 0.15f);
   task::ActionVector previous = task::ActionVector::Zero(6), wanted = previous;
   std::vector<float> records, expected;
   for (int t = 0; t < 300; ++t) {
-    const sim::Measurement m = sim::measure(nessie(), vehicle);
-    task::Observation obs;
-    obs.position_ned_m = m.eta.head<3>();
-    obs.euler_rpy_rad = m.eta.tail<3>();
-    obs.velocity_body_mps = m.nu.head<3>();
-    obs.angular_rate_body_rad_s = m.nu.tail<3>();
     task::StateVector state;
-    task::build_state(
-        c, obs, Eigen::Vector3d(0, 0, 5), previous, state,
-        std::vector<double>(m.thrust_realised_n.data(), m.thrust_realised_n.data() + 6));
+    task::build_state(c, report.observation, Eigen::Vector3d(0, 0, 5), previous, state,
+                      report.thrust_realised_n);
     for (int i = 0; i < 6; ++i) wanted[i] = std::clamp(wanted[i] + walk(rng), -1.0f, 1.0f);
     records.insert(records.end(), state.data(), state.data() + state.size());
     records.insert(records.end(), wanted.data(), wanted.data() + 6);
     task::ActionVector action = wanted;
     faults.apply(state, action);
     expected.insert(expected.end(), action.data(), action.data() + 6);
-    sim::step(nessie(), vehicle, (action.cast<double>() * c.max_thrust_n).eval());
+    std::vector<double> thrust_n(6);
+    for (int i = 0; i < 6; ++i) thrust_n[i] = action[i] * c.max_thrust_n;
+    report = *link->step(thrust_n);
     previous = action;
   }
   ASSERT_TRUE(faults.dead(5));
