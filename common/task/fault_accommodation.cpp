@@ -45,6 +45,9 @@ ThrusterFaultAccommodation::ThrusterFaultAccommodation(const TaskConfig& task) :
 
 void ThrusterFaultAccommodation::reset() {
   const int n = task_.num_thrusters;
+  previous_command_ = realised_n_ = keep_ = command_ = rhs_ = spread_ = Eigen::VectorXd::Zero(n);
+  system_ = Eigen::MatrixXd::Zero(n, n);
+  solver_ = Eigen::LDLT<Eigen::MatrixXd>(n);
   replica_delayed_n_ = replica_n_ = Eigen::VectorXd::Zero(n);
   moment_realised_replica_ = moment_replica_squared_ = Eigen::VectorXd::Zero(n);
   efficiency_ = Eigen::VectorXd::Ones(n);
@@ -87,17 +90,17 @@ void ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& s
   }
 }
 
-void ThrusterFaultAccommodation::redistribute(ActionVector& action) const {
+void ThrusterFaultAccommodation::redistribute(ActionVector& action) {
   const int n = task_.num_thrusters;
-  Eigen::VectorXd keep(n);
-  for (int i = 0; i < n; ++i) keep[i] = dead_[static_cast<std::size_t>(i)] ? 0.0 : 1.0;
-  const Eigen::VectorXd command = action.cast<double>();  // normalised: the scale cancels
-  Eigen::MatrixXd system = keep.asDiagonal() * wrench_gram_ * keep.asDiagonal();
-  system.diagonal().array() += damping_;
-  const Eigen::VectorXd rhs =
-      keep.asDiagonal() * (wrench_gram_ * command) + damping_ * keep.cwiseProduct(command);
-  const Eigen::VectorXd spread = system.ldlt().solve(rhs);
-  for (int i = 0; i < n; ++i) action[i] = static_cast<float>(std::clamp(spread[i], -1.0, 1.0));
+  for (int i = 0; i < n; ++i) keep_[i] = dead_[static_cast<std::size_t>(i)] ? 0.0 : 1.0;
+  command_ = action.cast<double>();  // normalised: the scale cancels
+  system_.noalias() = keep_.asDiagonal() * wrench_gram_ * keep_.asDiagonal();
+  system_.diagonal().array() += damping_;
+  rhs_.noalias() = wrench_gram_ * command_;
+  rhs_ = keep_.cwiseProduct(rhs_) + damping_ * keep_.cwiseProduct(command_);
+  solver_.compute(system_);
+  spread_ = solver_.solve(rhs_);
+  for (int i = 0; i < n; ++i) action[i] = static_cast<float>(std::clamp(spread_[i], -1.0, 1.0));
 }
 
 }  // namespace auvrl::task

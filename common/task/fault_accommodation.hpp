@@ -2,6 +2,7 @@
 // delivers, stop commanding it and give its share of the body wrench to the others.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <vector>
 
@@ -19,7 +20,7 @@ namespace auvrl::task {
 /// with B the thrusters' wrench matrix, E = diag(0 for a dead thruster, 1 otherwise) and
 /// lambda = damping * trace(B'B) / n. With every thruster healthy u' = u exactly; a dead one
 /// gets 0; the others take up its wrench as far as the damping lets them. Commands are clamped
-/// to [-1, 1] again.
+/// to [-1, 1] again. A step allocates nothing (a vehicle's control loop).
 class ThrusterFaultAccommodation {
  public:
   /// The estimate moves only while a healthy thruster would deliver at least this much (RMS
@@ -47,7 +48,7 @@ class ThrusterFaultAccommodation {
 
  private:
   void estimate(const Eigen::Ref<const StateVector>& state);
-  void redistribute(ActionVector& action) const;
+  void redistribute(ActionVector& action);
 
   TaskConfig task_;
   Eigen::MatrixXd wrench_gram_;                    ///< B'B, n x n
@@ -59,7 +60,10 @@ class ThrusterFaultAccommodation {
   Eigen::VectorXd moment_realised_replica_, moment_replica_squared_;
   Eigen::VectorXd efficiency_;
   std::vector<bool> dead_;
-  Eigen::VectorXd previous_command_, realised_n_;  ///< scratch
+  // Scratch, sized once: a step allocates nothing.
+  Eigen::VectorXd previous_command_, realised_n_, keep_, command_, rhs_, spread_;
+  Eigen::MatrixXd system_;
+  Eigen::LDLT<Eigen::MatrixXd> solver_;
 };
 
 }  // namespace auvrl::task
