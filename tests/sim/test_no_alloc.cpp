@@ -2,33 +2,15 @@
 // must not stall). This binary interposes malloc (glibc) to count calls while stepping.
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstddef>
-
-#include "sim_test_util.hpp"  // first: see the note on Eigen warnings there
-
-extern "C" void* __libc_malloc(std::size_t size);  // glibc's own allocator
-
-namespace {
-std::atomic<bool> g_counting{false};
-std::atomic<long> g_mallocs{0};
-}  // namespace
-
-extern "C" void* malloc(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_mallocs.fetch_add(1);
-  return __libc_malloc(size);
-}
+#include "malloc_counter.hpp"
+#include "sim_test_util.hpp"  // before any Eigen header: see the note on Eigen warnings there
 
 namespace auvrl::sim::test {
 namespace {
 
 TEST(NoAllocation, StepAndMeasureNeverAllocate) {
   // Sanity: the interposer sees allocations at all.
-  g_counting = true;
-  auto* probe = new std::vector<double>(100);
-  g_counting = false;
-  delete probe;
-  ASSERT_GT(g_mallocs.load(), 0);
+  ASSERT_GT(test_support::mallocs_during([] { delete new std::vector<double>(100); }), 0);
 
   for (const VehicleModel* m : {&nessie(), &nessie_munk(), &bluerov()}) {
     ResetSettings reset = reset_at_depth(5);
@@ -40,19 +22,18 @@ TEST(NoAllocation, StepAndMeasureNeverAllocate) {
     ThrusterVector command = ThrusterVector::Constant(m->num_thrusters(), 10.0);
     VehicleModel euler = *m;
     euler.integrator = Integrator::kSemiImplicitEuler;
-    g_mallocs = 0;
-    g_counting = true;
-    for (int k = 0; k < 1000; ++k) {
-      command(0) = (k % 20 < 10) ? 20.0 : -20.0;
-      step(*m, s, command);
-      step_ideal_thrusters(*m, s, command);
-      step(euler, s, command);
-      const Measurement z = measure(*m, s);
-      (void)z;
-    }
-    g_counting = false;
+    const long mallocs = test_support::mallocs_during([&] {
+      for (int k = 0; k < 1000; ++k) {
+        command(0) = (k % 20 < 10) ? 20.0 : -20.0;
+        step(*m, s, command);
+        step_ideal_thrusters(*m, s, command);
+        step(euler, s, command);
+        const Measurement z = measure(*m, s);
+        (void)z;
+      }
+    });
     EXPECT_EQ(s.status, StateStatus::kOk) << m->name;
-    EXPECT_EQ(g_mallocs.load(), 0) << m->name;
+    EXPECT_EQ(mallocs, 0) << m->name;
   }
 }
 
