@@ -43,10 +43,7 @@ void PolicyController::use_driving_aids(const task::TaskConfig& task) {
   if (task.integral.enabled() || position_filter_) driving_task_ = task;
   goal_offset_ned_m_.setZero();
   fault_accommodation_.reset();
-  // Only the extended_thrust layout shows the controller what each thruster delivers.
-  if (task.fault_accommodation.enabled && task.layout == task::StateLayout::kExtendedThrust) {
-    fault_accommodation_.emplace(task);
-  }
+  if (task::has_fault_accommodation(task)) fault_accommodation_.emplace(task);
 }
 
 void PolicyController::act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,

@@ -56,10 +56,6 @@ class PolicyController final : public Controller {
   /// Replaces the network (new weights from the learner); same size checks.
   void set_network(nn::Mlp network);
   const nn::Mlp& network() const { return network_; }
-  /// The fault accommodation at work, or null (off, or a layout without the realised thrust).
-  const task::ThrusterFaultAccommodation* fault_accommodation() const {
-    return fault_accommodation_ ? &*fault_accommodation_ : nullptr;
-  }
 
  private:
   nn::Mlp network_;

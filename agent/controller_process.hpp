@@ -19,7 +19,7 @@ struct ControllerProcessOptions {
   std::string controller = "policy";  ///< "policy" or "pid"
   std::string vehicle_path;           ///< "": the mission's vehicle:, else default_vehicle_file()
   std::string layout;                 ///< "": inferred from the policy's input size
-  /// The policy's integral action and position filter.
+  /// The policy's integral action, position filter and fault accommodation.
   task::DrivingAidOptions driving = {};
   /// An Ed25519 public key (PEM): the mission and the policy must then be signed by its
   /// private key (FILE.sig beside each, common/signature.hpp), or they are refused.

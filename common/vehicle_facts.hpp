@@ -43,12 +43,13 @@ struct VehicleFacts {
   std::string source_file;                      ///< path of the vehicle file
   std::uint32_t file_crc32 = 0;                 ///< CRC-32 of the vehicle file's bytes
   std::vector<std::string> thruster_names;      ///< in the file's order (action index i = T(i+1))
-  double max_thrust_n = 0;                      ///< action +-1 maps to +- this, N
   double control_step_s = 0;                    ///< s
   ThrusterDynamics thruster_dynamics;           ///< the thrusters' response
   std::vector<ThrusterWrench> thruster_wrench;  ///< per thruster, in the file's order
 
   int num_thrusters() const { return static_cast<int>(thruster_names.size()); }
+  /// Action +-1 maps to +- this, N (the thrusters' saturation).
+  double max_thrust_n() const { return thruster_dynamics.max_thrust_n; }
 };
 
 /// The identity a peer announces on the wire (sim heartbeat, reset reply).

@@ -346,7 +346,7 @@ void write_vehicle_csv(const std::string& path, const VehicleFacts& vehicle) {
                   csv::Mode::kTruncate, kCsvDigits);
   for (int i = 0; i < vehicle.num_thrusters(); ++i) {
     out.cell(vehicle.name).cell(vehicle.source_file).cell(i + 1);
-    out.cell(vehicle.thruster_names[static_cast<std::size_t>(i)]).cell(vehicle.max_thrust_n);
+    out.cell(vehicle.thruster_names[static_cast<std::size_t>(i)]).cell(vehicle.max_thrust_n());
     out.end_row();
   }
   out.flush();

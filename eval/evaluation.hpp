@@ -201,7 +201,7 @@ struct EvalRequest {
   /// scenarios.
   std::string mission_path;
   std::string layout;  ///< "paper", "extended", "extended_thrust" or empty: from the policy
-  /// The policy's integral action and position filter.
+  /// The policy's integral action, position filter and fault accommodation.
   task::DrivingAidOptions driving = {};
   std::uint64_t seed = 1;
   int suite_episodes = 100;

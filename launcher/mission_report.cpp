@@ -95,7 +95,7 @@ std::vector<eval::MissionWaypointRow> write_mission_record(const std::string& di
                                                            const MissionRecorder& recorder,
                                                            const MissionEventLog& events) {
   std::vector<agent::TrajectoryRow> rows = recorder.trajectory();
-  const MissionAnalysis analysis = analyse_waypoints(mission.waypoints, rows, facts.max_thrust_n);
+  const MissionAnalysis analysis = analyse_waypoints(mission.waypoints, rows, facts.max_thrust_n());
   const fs::path d = dir;
   eval::write_trajectory_csv((d / "trajectory.csv").string(), rows, facts.num_thrusters(),
                              &analysis.waypoint_index);

@@ -493,7 +493,6 @@ VehicleFacts VehicleModel::facts() const {
   f.source_file = source_file;
   f.file_crc32 = file_crc32;
   for (const Thruster& t : thrusters) f.thruster_names.push_back(t.name);
-  f.max_thrust_n = thruster_dynamics.max_thrust_n;
   f.control_step_s = control_step_s;
   f.thruster_dynamics = thruster_dynamics;
   for (Eigen::Index i = 0; i < allocation.cols(); ++i) {

@@ -8,6 +8,10 @@
 
 namespace auvrl::task {
 
+bool has_fault_accommodation(const TaskConfig& task) {
+  return task.fault_accommodation.enabled && task.layout == StateLayout::kExtendedThrust;
+}
+
 ThrusterFaultAccommodation::ThrusterFaultAccommodation(const TaskConfig& task) : task_(task) {
   const FaultAccommodationSettings& s = task.fault_accommodation;
   if (!s.enabled) throw std::invalid_argument("fault accommodation: it is off in the task");
@@ -23,11 +27,9 @@ ThrusterFaultAccommodation::ThrusterFaultAccommodation(const TaskConfig& task) :
                                 " thruster wrenches for " + std::to_string(n) +
                                 " thrusters (task::apply_vehicle sets them)");
   }
-  if (!(s.dead_below >= 0 && s.dead_below < 1) || !(s.estimate_time_constant_s > 0) ||
-      !(s.damping > 0) || !(task.control_step_s > 0)) {
-    throw std::invalid_argument(
-        "fault accommodation: dead_below must be in [0, 1), estimate_time_constant_s, damping "
-        "and the control step > 0");
+  s.validate();
+  if (!(task.control_step_s > 0)) {
+    throw std::invalid_argument("fault accommodation: the control step must be > 0");
   }
   Eigen::MatrixXd wrench(6, n);
   for (int i = 0; i < n; ++i) {

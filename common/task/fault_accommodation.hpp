@@ -10,6 +10,10 @@
 
 namespace auvrl::task {
 
+/// Whether a policy driving on this task has a fault accommodation: it is on and the layout
+/// carries the realised thrust (extended_thrust; the others drive without it).
+bool has_fault_accommodation(const TaskConfig& task);
+
 /// Task::FaultAccommodationSettings at work, one control step at a time. Each step it reads
 /// from the observation vector (extended_thrust layout) the commands of the step before and
 /// the thrust each thruster realised; a replica of a healthy thruster (the vehicle's delay, lag

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "common/random.hpp"
 
@@ -108,14 +109,7 @@ void TaskConfig::validate() const {
         fmt::format("task.position_filter.time_constant_s must be in [0, {}] (s), got {}",
                     PositionFilterSettings::kMaxTimeConstantS, position_filter.time_constant_s));
   }
-  const FaultAccommodationSettings& fa = fault_accommodation;
-  if (!(fa.dead_below >= 0 && fa.dead_below < 1)) {
-    throw std::invalid_argument(
-        fmt::format("task.fault_accommodation.dead_below must be in [0, 1) (an efficiency), got {}",
-                    fa.dead_below));
-  }
-  positive(fa.estimate_time_constant_s, "fault_accommodation.estimate_time_constant_s");
-  positive(fa.damping, "fault_accommodation.damping");
+  fault_accommodation.validate();
   if (!(integral.max_offset_m >= 0) || !std::isfinite(integral.max_offset_m)) {
     throw std::invalid_argument("task.integral.max_offset_m must be finite and >= 0");
   }
@@ -222,6 +216,21 @@ void relabel_state(const TaskConfig& c, const Eigen::Vector3d& old_goal,
     state.segment<3>(kPaperPosition) += (shift_ned_m / c.scales.position_m).cast<float>();
   } else {
     state[kExtAction + c.num_thrusters] += static_cast<float>(shift_ned_m.z() / c.scales.depth_m);
+  }
+}
+
+void FaultAccommodationSettings::validate() const {
+  if (!(dead_below >= 0 && dead_below < 1)) {
+    throw std::invalid_argument(
+        fmt::format("task.fault_accommodation.dead_below must be in [0, 1) (an efficiency), got {}",
+                    dead_below));
+  }
+  for (const auto& [value, name] : {std::pair{estimate_time_constant_s, "estimate_time_constant_s"},
+                                    std::pair{damping, "damping"}}) {
+    if (!std::isfinite(value) || value <= 0) {
+      throw std::invalid_argument(
+          fmt::format("task.fault_accommodation.{} must be finite and > 0, got {}", name, value));
+    }
   }
 }
 
@@ -391,7 +400,7 @@ StartState sample_start(const TaskConfig& c, std::mt19937_64& rng) {
 
 void apply_vehicle(const VehicleFacts& vehicle, TaskConfig& task) {
   task.num_thrusters = vehicle.num_thrusters();
-  task.max_thrust_n = vehicle.max_thrust_n;
+  task.max_thrust_n = vehicle.max_thrust_n();
   task.control_step_s = vehicle.control_step_s;
   task.thruster_dynamics = vehicle.thruster_dynamics;
   task.thruster_wrench = vehicle.thruster_wrench;

@@ -115,6 +115,8 @@ struct FaultAccommodationSettings {
   /// wrench matrix: small values rebuild the whole wrench with the remaining thrusters, large
   /// ones only stop commanding the dead thruster.
   double damping = 1.0;
+  /// Throws std::invalid_argument naming the first unusable value (task.fault_accommodation.*).
+  void validate() const;
 };
 
 /// Every constant of the task. Defaults are the paper's where it gives one.

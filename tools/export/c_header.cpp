@@ -54,11 +54,8 @@ double position_filter_gain(const task::TaskConfig& task) {
 /// The task's fault accommodation when the policy has one (on, and a layout with the realised
 /// thrust), as auvrl's policy controller builds it.
 std::optional<task::ThrusterFaultAccommodation> fault_accommodation(const ExportedPolicy& policy) {
-  const task::TaskConfig& task = policy.task;
-  if (!task.fault_accommodation.enabled || task.layout != task::StateLayout::kExtendedThrust) {
-    return std::nullopt;
-  }
-  return task::ThrusterFaultAccommodation(task);
+  if (!task::has_fault_accommodation(policy.task)) return std::nullopt;
+  return task::ThrusterFaultAccommodation(policy.task);
 }
 
 /// The header's opening comment: what it holds and how a vehicle uses it.

@@ -9,6 +9,7 @@
 #include "common/nn/checksum.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
+#include "common/task/fault_accommodation.hpp"
 #include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -205,7 +206,7 @@ std::string describe_policy(const ExportedPolicy& policy) {
   const task::FaultAccommodationSettings& faults = policy.task.fault_accommodation;
   if (!faults.enabled) {
     out += "Fault accommodation: off (the actions go to the thrusters as they are).\n";
-  } else if (policy.task.layout != task::StateLayout::kExtendedThrust) {
+  } else if (!task::has_fault_accommodation(policy.task)) {
     out += "Fault accommodation: none (this layout does not carry the realised thrust).\n";
   } else {
     out += fmt::format(

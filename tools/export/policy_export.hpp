@@ -17,7 +17,7 @@ struct ExportRequest {
   std::string vehicle_path;  ///< vehicle file: thruster names, maximum thrust, thruster count
   std::string layout;        ///< "paper", "extended", "extended_thrust" or empty: inferred
   OnnxWriter onnx;           ///< how to run scripts/export_onnx.py (format "onnx")
-  /// The policy's integral action and position filter.
+  /// The policy's integral action, position filter and fault accommodation.
   task::DrivingAidOptions driving = {};
 };
 
