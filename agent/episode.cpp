@@ -53,6 +53,66 @@ bool usable(const VehicleReport& r) {
   return !r.blown_up && o.position_ned_m.allFinite() && o.euler_rpy_rad.allFinite() &&
          o.velocity_body_mps.allFinite() && o.angular_rate_body_rad_s.allFinite();
 }
+
+/// What an episode measures of where the vehicle went, step by step: the distances, the thrust
+/// energy, the first arrival within the reach radius and the mean error from then on.
+class EpisodeFigures {
+ public:
+  EpisodeFigures(EpisodeSummary& summary, double reach_radius_m, double control_step_s)
+      : summary_(summary), reach_radius_m_(reach_radius_m), control_step_s_(control_step_s) {}
+
+  /// Step `step` commanded `action` and left the vehicle `measured_m` from the goal.
+  void record(int step, const task::ActionVector& action, double measured_m) {
+    summary_.length_steps = step;
+    summary_.thrust_energy += static_cast<double>(action.squaredNorm()) / action.size();
+    summary_.final_distance_m = measured_m;
+    summary_.min_distance_m = std::min(summary_.min_distance_m, measured_m);
+    if (summary_.time_to_reach_s < 0 && measured_m <= reach_radius_m_) {
+      summary_.time_to_reach_s = step * control_step_s_;
+    }
+    if (summary_.time_to_reach_s >= 0) {
+      error_sum_after_reach_m_ += measured_m;
+      ++steps_after_reach_;
+    }
+  }
+
+  int steps_after_reach() const { return steps_after_reach_; }
+
+  /// The mean error after arrival, once the episode is over.
+  void finish() {
+    if (steps_after_reach_ > 0) {
+      summary_.mean_error_after_reach_m = error_sum_after_reach_m_ / steps_after_reach_;
+    }
+  }
+
+ private:
+  EpisodeSummary& summary_;
+  double reach_radius_m_;
+  double control_step_s_;
+  double error_sum_after_reach_m_ = 0.0;
+  int steps_after_reach_ = 0;
+};
+
+/// After step `step` of an episode: whether it stops, recording why in `summary`. An episode
+/// that reached its goal with options.run_full_time goes on (`task_ended` set: no more
+/// transitions or return), so that the evaluation sees the vehicle hold station.
+bool episode_stops(const task::StepOutcome& outcome, const EpisodeOptions& options, int step,
+                   int max_steps, int steps_after_reach, EpisodeSummary& summary,
+                   bool& task_ended) {
+  if (options.steps_after_reach >= 0 && steps_after_reach > options.steps_after_reach) {
+    if (summary.end_reason == task::EndReason::kNone) summary.end_reason = outcome.reason;
+    return true;
+  }
+  if (!outcome.done) return false;
+  const bool keep_going =
+      options.run_full_time && outcome.reason == task::EndReason::kReached && step < max_steps;
+  if (summary.end_reason == task::EndReason::kNone || !keep_going) {
+    summary.end_reason = outcome.reason;
+  }
+  if (!keep_going) return true;
+  task_ended = true;
+  return false;
+}
 }  // namespace
 
 EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
@@ -92,8 +152,7 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
   };
   summary.min_distance_m = true_distance(*report, distance);
   std::vector<double> thrust_n(static_cast<std::size_t>(n));
-  double error_sum_after_reach = 0.0;
-  int steps_after_reach = 0;
+  EpisodeFigures figures(summary, options.reach_radius_m, task.control_step_s);
   bool task_ended = false;  // reached (when running the full time anyway)
 
   for (int t = 1; t <= task.max_steps; ++t) {
@@ -127,18 +186,8 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
       }
       summary.episode_return += outcome.reward;
     }
-    summary.length_steps = t;
-    summary.thrust_energy += static_cast<double>(action.squaredNorm()) / n;
     const double measured_m = true_distance(*next, next_distance);
-    summary.final_distance_m = measured_m;
-    summary.min_distance_m = std::min(summary.min_distance_m, measured_m);
-    if (summary.time_to_reach_s < 0 && measured_m <= options.reach_radius_m) {
-      summary.time_to_reach_s = t * task.control_step_s;
-    }
-    if (summary.time_to_reach_s >= 0) {
-      error_sum_after_reach += measured_m;
-      ++steps_after_reach;
-    }
+    figures.record(t, action, measured_m);
     if (outcome.inside_goal) summary.success = true;
     if (options.trajectory) {
       options.trajectory->push_back(
@@ -149,24 +198,14 @@ EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Cont
     state.swap(next_state);
     previous_action = action;
     distance = next_distance;
-    if (options.steps_after_reach >= 0 && steps_after_reach > options.steps_after_reach) {
-      if (summary.end_reason == task::EndReason::kNone) summary.end_reason = outcome.reason;
+    if (episode_stops(outcome, options, t, task.max_steps, figures.steps_after_reach(), summary,
+                      task_ended)) {
       break;
-    }
-    if (outcome.done) {
-      const bool keep_going = options.run_full_time &&
-                              outcome.reason == task::EndReason::kReached && t < task.max_steps;
-      if (summary.end_reason == task::EndReason::kNone || !keep_going) {
-        summary.end_reason = outcome.reason;
-      }
-      if (!keep_going) break;
-      task_ended = true;
     }
   }
   if (summary.end_reason == task::EndReason::kNone)
     summary.end_reason = task::EndReason::kTimeLimit;
-  if (steps_after_reach > 0)
-    summary.mean_error_after_reach_m = error_sum_after_reach / steps_after_reach;
+  figures.finish();
   return summary;
 }
 

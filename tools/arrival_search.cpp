@@ -124,6 +124,52 @@ double cost(const Rollout& r, int horizon_steps, double radius_m, double stay_wi
   return horizon_steps + 1.0 + 10.0 * (r.closest_m - radius_m);
 }
 
+/// The search's start: the PID's commands (trajectory row t holds the command of step t),
+/// normalised and averaged over each segment of `steps_per_segment` steps, for `steps` steps.
+Eigen::MatrixXd segment_means(const std::vector<agent::TrajectoryRow>& pid_trajectory, int steps,
+                              int segments, int steps_per_segment, int num_thrusters,
+                              double max_thrust_n) {
+  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(segments, num_thrusters);
+  Eigen::VectorXi count = Eigen::VectorXi::Zero(segments);
+  for (int t = 1; t <= steps && t < static_cast<int>(pid_trajectory.size()); ++t) {
+    const int s = (t - 1) / steps_per_segment;
+    for (int i = 0; i < num_thrusters; ++i) {
+      mean(s, i) += pid_trajectory[static_cast<std::size_t>(t)]
+                        .thrust_command_n[static_cast<std::size_t>(i)] /
+                    max_thrust_n;
+    }
+    ++count[s];
+  }
+  for (int s = 0; s < segments; ++s) {
+    if (count[s] > 0) mean.row(s) /= count[s];
+  }
+  return mean;
+}
+
+/// The cross-entropy method's update: the sampling mean and spread move towards those of the
+/// `search.elites` best samples (`ranked` in order, best first), smoothed, the spread kept at
+/// least search.min_sigma.
+void refit_to_elites(const std::vector<Eigen::MatrixXd>& samples,
+                     const std::vector<std::pair<double, int>>& ranked,
+                     const ArrivalSearchConfig& search, Eigen::MatrixXd& mean,
+                     Eigen::MatrixXd& sigma) {
+  const auto elite = [&](int e) -> const Eigen::MatrixXd& {
+    return samples[static_cast<std::size_t>(ranked[static_cast<std::size_t>(e)].second)];
+  };
+  Eigen::MatrixXd elite_mean = Eigen::MatrixXd::Zero(mean.rows(), mean.cols());
+  for (int e = 0; e < search.elites; ++e) elite_mean += elite(e);
+  elite_mean /= search.elites;
+  Eigen::MatrixXd elite_var = Eigen::MatrixXd::Zero(mean.rows(), mean.cols());
+  for (int e = 0; e < search.elites; ++e) {
+    elite_var += (elite(e) - elite_mean).array().square().matrix();
+  }
+  elite_var /= search.elites;
+  mean = (1.0 - search.smoothing) * elite_mean + search.smoothing * mean;
+  sigma = ((1.0 - search.smoothing) * elite_var.array().sqrt() + search.smoothing * sigma.array())
+              .max(search.min_sigma)
+              .matrix();
+}
+
 }  // namespace
 
 ArrivalSearchResult search_fastest_arrival(
@@ -150,22 +196,8 @@ ArrivalSearchResult search_fastest_arrival(
   const int stay = search.stay_within_m > 0 ? search.stay_steps : 0;
   const int segments = (horizon + stay + search.steps_per_segment - 1) / search.steps_per_segment;
 
-  // The start: the PID's commands (trajectory row t holds the command of step t), averaged
-  // over each segment.
-  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(segments, n);
-  Eigen::VectorXi count = Eigen::VectorXi::Zero(segments);
-  for (int t = 1; t <= horizon + stay && t < static_cast<int>(pid_trajectory.size()); ++t) {
-    const int s = (t - 1) / search.steps_per_segment;
-    for (int i = 0; i < n; ++i) {
-      mean(s, i) += pid_trajectory[static_cast<std::size_t>(t)]
-                        .thrust_command_n[static_cast<std::size_t>(i)] /
-                    config.task.max_thrust_n;
-    }
-    ++count[s];
-  }
-  for (int s = 0; s < segments; ++s) {
-    if (count[s] > 0) mean.row(s) /= count[s];
-  }
+  Eigen::MatrixXd mean = segment_means(pid_trajectory, horizon + stay, segments,
+                                       search.steps_per_segment, n, config.task.max_thrust_n);
 
   RolloutRunner runner(model, config, episode, search.steps_per_segment);
   auto cost_of = [&](const Rollout& r) {
@@ -208,24 +240,7 @@ ArrivalSearchResult search_fastest_arrival(
       best = samples[static_cast<std::size_t>(top)];
       best_rollout = rollouts[static_cast<std::size_t>(top)];
     }
-    Eigen::MatrixXd elite_mean = Eigen::MatrixXd::Zero(segments, n);
-    for (int e = 0; e < search.elites; ++e) {
-      elite_mean += samples[static_cast<std::size_t>(ranked[static_cast<std::size_t>(e)].second)];
-    }
-    elite_mean /= search.elites;
-    Eigen::MatrixXd elite_var = Eigen::MatrixXd::Zero(segments, n);
-    for (int e = 0; e < search.elites; ++e) {
-      elite_var += (samples[static_cast<std::size_t>(ranked[static_cast<std::size_t>(e)].second)] -
-                    elite_mean)
-                       .array()
-                       .square()
-                       .matrix();
-    }
-    elite_var /= search.elites;
-    mean = (1.0 - search.smoothing) * elite_mean + search.smoothing * mean;
-    sigma = ((1.0 - search.smoothing) * elite_var.array().sqrt() + search.smoothing * sigma.array())
-                .max(search.min_sigma)
-                .matrix();
+    refit_to_elites(samples, ranked, search, mean, sigma);
     result.best_so_far_step.push_back(counted_step(best_rollout));
     result.iteration_best_step.push_back(counted_step(rollouts[static_cast<std::size_t>(top)]));
     if (progress) progress(it, counted_step(best_rollout));
