@@ -57,6 +57,75 @@ std::int64_t csv_rows(const std::string& path) {
 
 int exit_code(int status) { return WIFEXITED(status) ? WEXITSTATUS(status) : -1; }
 
+std::int64_t total(const Counts& counts) {
+  std::int64_t n = 0;
+  for (const auto& [channel, count] : counts) n += count;
+  return n;
+}
+
+/// A burst of 20 policy weights (200 kB each) with their small summaries, counted in
+/// `published`: the logger throttles the weights to one per 10 s and logs every summary.
+void publish_weight_burst(transport::Transport& transport, Counts& published) {
+  const logger::Schema schema = logger::Schema::from_directories({logger::default_types_dir()});
+  const std::vector<std::uint8_t> summary_bytes =
+      logger::make_sample_message(*schema.find_by_name("auvrl_lcm.policy_summary_t"), 1);
+  logger::SampleOptions big;
+  big.min_variable_length = big.max_variable_length = 200000;  // num_bytes of the network
+  const std::vector<std::uint8_t> weights =
+      logger::make_sample_message(*schema.find_by_name("auvrl_lcm.policy_weights_t"), 2, big);
+  for (int i = 0; i < 20; ++i) {
+    transport.publish(channels::kPolicyWeights, weights.data(), weights.size());
+    transport.publish(channels::kPolicySummary, summary_bytes.data(), summary_bytes.size());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  published[channels::kPolicyWeights] = 20;
+  published[channels::kPolicySummary] = 20;
+}
+
+/// auv_log export of `log_dir` (into dir/csv): one CSV per channel, as many rows as the log has
+/// messages.
+void expect_export_matches(const std::string& log_dir, const std::string& dir,
+                           const Counts& logged) {
+  const std::string csv_dir = dir + "/csv";
+  ChildProcess exporter({test_support::bin_path("auv_log"), "export", log_dir, "--out", csv_dir},
+                        dir + "/export.log");
+  ASSERT_EQ(exit_code(exporter.wait_for_exit(std::chrono::seconds(60))), 0) << exporter.log();
+  for (const auto& [channel, count] : logged) {
+    // LCM's multicast self-test message ("lcm self test", no type), sent by a process when it
+    // starts receiving, is logged when the logger is already listening; nothing decodes it.
+    if (channel == "LCM_SELF_TEST") continue;
+    EXPECT_EQ(csv_rows(csv_dir + "/" + channel + ".csv"), count) << channel;
+  }
+}
+
+/// lcm-logplayer replays the log `files` (joined: the format has no header) to a subscriber on
+/// `transport`, which must receive what was logged. auv_sim is gone, so the replayed commands
+/// step nothing.
+void expect_replay_matches(transport::Transport& transport, const std::vector<std::string>& files,
+                           const std::string& dir, const Counts& logged) {
+  const std::string joined = dir + "/joined.lcmlog";
+  {
+    std::ofstream out(joined, std::ios::binary);
+    for (const std::string& file : files) out << std::ifstream(file, std::ios::binary).rdbuf();
+  }
+  Counts replayed;
+  transport.subscribe(
+      ".*", [&](const transport::RawMessage& raw) { ++replayed[raw.channel]; }, 100000);
+  transport.drain();
+  replayed.clear();
+  ChildProcess player(
+      {AUVRL_LCM_LOGPLAYER, "--speed=4", "--lcm-url=udpm://239.255.76.67:7667?ttl=0", joined},
+      dir + "/logplayer.log");
+  const auto replay_deadline = Clock::now() + std::chrono::seconds(120);
+  while (player.running() && Clock::now() < replay_deadline) transport.handle(20);
+  ASSERT_FALSE(player.running()) << "lcm-logplayer did not finish";
+  const auto tail = Clock::now() + std::chrono::milliseconds(500);
+  while (Clock::now() < tail) transport.handle(20);
+  EXPECT_EQ(replayed, logged) << player.log();
+  std::cout << "[ measured ] lcm-logplayer replayed " << total(replayed) << " of " << total(logged)
+            << " messages\n";
+}
+
 TEST(LoggerProcess, LogsExactlyWhatWasSentExportsAndReplaysIt) {
   const std::string dir = test_support::make_temp_dir("auvrl_logger_process_");
   const std::string log_dir = dir + "/logs";
@@ -109,22 +178,7 @@ TEST(LoggerProcess, LogsExactlyWhatWasSentExportsAndReplaysIt) {
   published[channels::sim_reset(1)] = 1;
   published[channels::sim_command(0)] = kStepsPerVehicle;
   published[channels::sim_command(1)] = kStepsPerVehicle;
-  // A burst of policy weights (200 kB each) with their small summaries: the weights are
-  // throttled to one per 10 s, the summaries all logged.
-  const logger::Schema schema = logger::Schema::from_directories({logger::default_types_dir()});
-  const std::vector<std::uint8_t> summary_bytes =
-      logger::make_sample_message(*schema.find_by_name("auvrl_lcm.policy_summary_t"), 1);
-  logger::SampleOptions big;
-  big.min_variable_length = big.max_variable_length = 200000;  // num_bytes of the network
-  const std::vector<std::uint8_t> weights =
-      logger::make_sample_message(*schema.find_by_name("auvrl_lcm.policy_weights_t"), 2, big);
-  for (int i = 0; i < 20; ++i) {
-    transport->publish(channels::kPolicyWeights, weights.data(), weights.size());
-    transport->publish(channels::kPolicySummary, summary_bytes.data(), summary_bytes.size());
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  published[channels::kPolicyWeights] = 20;
-  published[channels::kPolicySummary] = 20;
+  publish_weight_burst(*transport, published);
   // States still in flight are collected, then the logger is stopped.
   const auto settle = Clock::now() + std::chrono::milliseconds(500);
   while (Clock::now() < settle) transport->handle(20);
@@ -151,8 +205,7 @@ TEST(LoggerProcess, LogsExactlyWhatWasSentExportsAndReplaysIt) {
   ASSERT_TRUE(summary_file) << logger_process.log();
   std::stringstream summary;
   summary << summary_file.rdbuf();
-  std::int64_t total_logged = 0;
-  for (const auto& [channel, count] : logged) total_logged += count;
+  const std::int64_t total_logged = total(logged);
   EXPECT_NE(summary.str().find("written " + std::to_string(total_logged) +
                                " throttled 19 "
                                "write_errors 0"),
@@ -165,43 +218,8 @@ TEST(LoggerProcess, LogsExactlyWhatWasSentExportsAndReplaysIt) {
             << " messages in " << files.size() << " files\n"
             << summary.str();
 
-  // auv_log export: one CSV per channel, as many rows as the log has messages.
-  const std::string csv_dir = dir + "/csv";
-  ChildProcess exporter({test_support::bin_path("auv_log"), "export", log_dir, "--out", csv_dir},
-                        dir + "/export.log");
-  ASSERT_EQ(exit_code(exporter.wait_for_exit(std::chrono::seconds(60))), 0) << exporter.log();
-  for (const auto& [channel, count] : logged) {
-    // LCM's multicast self-test message ("lcm self test", no type), sent by a process when it
-    // starts receiving, is logged when the logger is already listening; nothing decodes it.
-    if (channel == "LCM_SELF_TEST") continue;
-    EXPECT_EQ(csv_rows(csv_dir + "/" + channel + ".csv"), count) << channel;
-  }
-
-  // lcm-logplayer replays the log (the files joined: the format has no header) to a subscriber
-  // in this namespace. auv_sim is gone, so the replayed commands step nothing.
-  const std::string joined = dir + "/joined.lcmlog";
-  {
-    std::ofstream out(joined, std::ios::binary);
-    for (const std::string& file : files) out << std::ifstream(file, std::ios::binary).rdbuf();
-  }
-  Counts replayed;
-  transport->subscribe(
-      ".*", [&](const transport::RawMessage& raw) { ++replayed[raw.channel]; }, 100000);
-  transport->drain();
-  replayed.clear();
-  ChildProcess player(
-      {AUVRL_LCM_LOGPLAYER, "--speed=4", "--lcm-url=udpm://239.255.76.67:7667?ttl=0", joined},
-      dir + "/logplayer.log");
-  const auto replay_deadline = Clock::now() + std::chrono::seconds(120);
-  while (player.running() && Clock::now() < replay_deadline) transport->handle(20);
-  ASSERT_FALSE(player.running()) << "lcm-logplayer did not finish";
-  const auto tail = Clock::now() + std::chrono::milliseconds(500);
-  while (Clock::now() < tail) transport->handle(20);
-  EXPECT_EQ(replayed, logged) << player.log();
-  std::int64_t total_replayed = 0;
-  for (const auto& [channel, count] : replayed) total_replayed += count;
-  std::cout << "[ measured ] lcm-logplayer replayed " << total_replayed << " of " << total_logged
-            << " messages\n";
+  expect_export_matches(log_dir, dir, logged);
+  expect_replay_matches(*transport, files, dir, logged);
   fs::remove_all(dir);
 }
 
