@@ -75,6 +75,41 @@ std::vector<fs::path> log_files(const fs::path& dir) {
   return files;
 }
 
+/// The log files a killed logger wrote are readable to their last complete event: damage, if
+/// any, only at the very end of the last file (the one being written).
+void expect_readable_to_last_event(const std::vector<fs::path>& files) {
+  for (const fs::path& file : files) {
+    logger::LogReader reader(file.string());
+    logger::LogEvent event;
+    std::int64_t events = 0;
+    while (reader.next(event)) ++events;
+    EXPECT_GT(events, 0) << file;
+    ASSERT_LE(reader.damage().size(), 1u) << file;
+    if (!reader.damage().empty()) {
+      const logger::LogDamage& d = reader.damage().front();
+      EXPECT_EQ(file, files.back()) << "only the file being written can be torn";
+      EXPECT_EQ(d.offset + d.bytes_skipped, reader.file_size()) << file << ": " << d.what;
+    }
+  }
+}
+
+/// The checkpoint in `checkpoint_dir`, read in this process by a learner configured from
+/// `config_file`, holds the update count and replay size the resumed learner reported.
+void expect_checkpoint_holds(const std::string& config_file, const std::string& checkpoint_dir,
+                             std::int64_t updates, std::int64_t transitions) {
+  learner::LearnerNodeConfig config;
+  learner::read_learner_config_file(config_file, config);
+  config.checkpoint_dir = checkpoint_dir;
+  config.max_actors = 2;
+  auto transport = transport::make_in_process_transport();
+  std::ostringstream log;
+  learner::LearnerNode node(config, *transport, log);
+  node.resume();
+  EXPECT_EQ(node.updates(), updates) << log.str();
+  EXPECT_EQ(static_cast<std::int64_t>(node.replay().size()), transitions);
+  EXPECT_GT(transitions, 0);
+}
+
 TEST(LauncherFaults, KilledAndHungProcessesComeBackAndNothingIsLost) {
   const std::string tmp = test_support::make_temp_dir("auvrl_faults_");
   const std::string dir = tmp + "/run";
@@ -114,19 +149,7 @@ TEST(LauncherFaults, KilledAndHungProcessesComeBackAndNothingIsLost) {
         << train.log();
     EXPECT_TRUE(wait_for([&] { return log_files(run / "logs").size() > before.size(); }, 15))
         << "the restarted logger starts a new file";
-    for (const fs::path& file : before) {
-      logger::LogReader reader(file.string());
-      logger::LogEvent event;
-      std::int64_t events = 0;
-      while (reader.next(event)) ++events;
-      EXPECT_GT(events, 0) << file;
-      ASSERT_LE(reader.damage().size(), 1u) << file;
-      if (!reader.damage().empty()) {
-        const logger::LogDamage& d = reader.damage().front();
-        EXPECT_EQ(file, before.back()) << "only the file being written can be torn";
-        EXPECT_EQ(d.offset + d.bytes_skipped, reader.file_size()) << file << ": " << d.what;
-      }
-    }
+    expect_readable_to_last_event(before);
   }
 
   // A simulator that hangs: its heartbeat stops, the launcher kills and restarts it.
@@ -166,19 +189,7 @@ TEST(LauncherFaults, KilledAndHungProcessesComeBackAndNothingIsLost) {
     const std::int64_t resumed_updates = std::stoll(m[2]);
     const std::int64_t resumed_transitions = std::stoll(m[3]);
     EXPECT_EQ(resumed_updates, newest.updates);
-
-    // What the checkpoint holds, read in this process.
-    learner::LearnerNodeConfig config;
-    learner::read_learner_config_file(dir + "/config.yaml", config);
-    config.checkpoint_dir = copy_dir;
-    config.max_actors = 2;
-    auto transport = transport::make_in_process_transport();
-    std::ostringstream log;
-    learner::LearnerNode node(config, *transport, log);
-    node.resume();
-    EXPECT_EQ(node.updates(), newest.updates) << log.str();
-    EXPECT_EQ(static_cast<std::int64_t>(node.replay().size()), resumed_transitions);
-    EXPECT_GT(resumed_transitions, 0);
+    expect_checkpoint_holds(dir + "/config.yaml", copy_dir, newest.updates, resumed_transitions);
   }
 
   // An actor that hangs: no more episode reports; killed and restarted.

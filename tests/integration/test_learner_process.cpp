@@ -114,6 +114,49 @@ learner::LearnerNodeConfig in_process_config(const std::string& dir) {
   return c;
 }
 
+/// Hostile batches, which the learner must drop and count, never apply: one without
+/// transitions, one with a NaN reward, one with an action no tanh gives and one from an actor
+/// it does not know. (Sound experience of other dimensions is not hostile but another
+/// vehicle's: it stops the learner, tests/integration/test_vehicle_mismatch.cpp.)
+void send_hostile_batches(FakeActor& actor) {
+  actor.send(actor.make_batch(0));
+  auto nan = actor.make_batch(5);
+  nan.rewards[2] = std::nanf("");
+  actor.send(nan);
+  auto wild = actor.make_batch(5);
+  wild.actions[0][0] = 7.0f;
+  actor.send(wild);
+  auto stranger = actor.make_batch(5);
+  stranger.actor_id = 99;
+  actor.send(stranger);
+}
+
+/// The newest checkpoint in dir/checkpoints, resumed in this process, holds `updates` and
+/// exactly the transitions `sent`, in order.
+void expect_checkpoint_holds(const std::string& dir,
+                             const std::vector<auvrl_lcm::experience_batch_t>& sent,
+                             std::int64_t updates) {
+  std::ostringstream log;
+  auto t = transport::make_in_process_transport();
+  learner::LearnerNode restored(in_process_config(dir), *t, log);
+  restored.resume();
+  ASSERT_EQ(restored.updates(), updates);
+  const auto& replay = restored.replay();
+  std::size_t slot = 0;
+  for (const auto& batch : sent) {
+    for (int i = 0; i < batch.num_transitions; ++i, ++slot) {
+      ASSERT_LT(slot, replay.size());
+      for (int k = 0; k < kStateDim; ++k) {
+        ASSERT_EQ(replay.state(slot)[k], batch.states[i][k]) << "slot " << slot;
+        ASSERT_EQ(replay.next_state(slot)[k], batch.next_states[i][k]);
+      }
+      ASSERT_EQ(replay.reward(slot), batch.rewards[i]);
+      ASSERT_EQ(replay.terminal(slot), batch.terminal[i] != 0);
+    }
+  }
+  EXPECT_EQ(replay.size(), slot) << "the buffer holds more than was sent";
+}
+
 TEST(LearnerProcess, WeightsRiseCheckpointKillResume) {
   const std::string dir = test_support::make_temp_dir("auvrl_learner_process_");
   auto learner = std::make_unique<ChildProcess>(learner_args(dir, false), dir + "/learner1.log");
@@ -157,19 +200,7 @@ TEST(LearnerProcess, WeightsRiseCheckpointKillResume) {
   EXPECT_EQ(seen.size(), static_cast<std::size_t>(240 - kBatch + 1))
       << "weights were not broadcast after each update";
 
-  // Hostile batches: dropped and counted, never applied.
-  // (Sound experience of other dimensions is not hostile but another vehicle's: it stops the
-  // learner, tests/integration/test_vehicle_mismatch.cpp.)
-  a.send(a.make_batch(0));  // no transitions
-  auto nan = a.make_batch(5);
-  nan.rewards[2] = std::nanf("");
-  a.send(nan);
-  auto wild = a.make_batch(5);
-  wild.actions[0][0] = 7.0f;  // not a tanh output
-  a.send(wild);
-  auto stranger = a.make_batch(5);
-  stranger.actor_id = 99;
-  a.send(stranger);
+  send_hostile_batches(a);
   std::optional<auvrl_lcm::learner_stats_t> s;
   for (int i = 0; i < 60; ++i) {
     a.pump(50);
@@ -192,27 +223,7 @@ TEST(LearnerProcess, WeightsRiseCheckpointKillResume) {
   ASSERT_FALSE(files.empty());
   EXPECT_EQ(files.front().updates, 240 - kBatch);
 
-  // The checkpoint holds exactly what was sent, in order.
-  {
-    std::ostringstream log;
-    auto t = transport::make_in_process_transport();
-    learner::LearnerNode restored(in_process_config(dir), *t, log);
-    restored.resume();
-    ASSERT_EQ(restored.updates(), 240 - kBatch);
-    const auto& replay = restored.replay();
-    ASSERT_EQ(replay.size(), 240u);
-    std::size_t slot = 0;
-    for (const auto& batch : sent) {
-      for (int i = 0; i < batch.num_transitions; ++i, ++slot) {
-        for (int k = 0; k < kStateDim; ++k) {
-          ASSERT_EQ(replay.state(slot)[k], batch.states[i][k]) << "slot " << slot;
-          ASSERT_EQ(replay.next_state(slot)[k], batch.next_states[i][k]);
-        }
-        ASSERT_EQ(replay.reward(slot), batch.rewards[i]);
-        ASSERT_EQ(replay.terminal(slot), batch.terminal[i] != 0);
-      }
-    }
-  }
+  expect_checkpoint_holds(dir, sent, 240 - kBatch);
 
   // --resume: the same update count, the same buffer, and the weights of that checkpoint.
   learner = std::make_unique<ChildProcess>(learner_args(dir, true), dir + "/learner2.log");

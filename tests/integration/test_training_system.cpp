@@ -22,6 +22,32 @@ using test_support::ChildProcess;
 /// The transport every process of a run uses.
 class TrainingSystem : public ::testing::TestWithParam<transport::TransportKind> {};
 
+/// Actor `id` reported 30 episodes or more, none lost, with policy versions that rose and never
+/// went back.
+void expect_actor_learning(int id, const std::vector<auvrl_lcm::episode_report_t>& list,
+                           const std::string& logs) {
+  ASSERT_GE(list.size(), 30u) << "actor " << id << " reported too few episodes\n" << logs;
+  EXPECT_GT(list.back().policy_version, list.front().policy_version)
+      << "actor " << id << " did not pick up new weights";
+  EXPECT_GT(list.back().policy_version, 0);
+  for (std::size_t i = 1; i < list.size(); ++i) {
+    EXPECT_EQ(list[i].episode_id, list[i - 1].episode_id + 1) << "an episode report was lost";
+    EXPECT_GE(list[i].policy_version, list[i - 1].policy_version) << "policy went backwards";
+  }
+}
+
+/// The messages the logger's heartbeat says it wrote on `channel` (0 without a heartbeat).
+std::int64_t written_on(const std::optional<auvrl_lcm::logger_heartbeat_t>& heartbeat,
+                        const std::string& channel) {
+  if (!heartbeat) return 0;
+  for (int i = 0; i < heartbeat->num_channels; ++i) {
+    if (heartbeat->channel[static_cast<std::size_t>(i)] == channel) {
+      return heartbeat->written[static_cast<std::size_t>(i)];
+    }
+  }
+  return 0;
+}
+
 TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
   const std::string dir = test_support::make_temp_dir("auvrl_training_system_");
   transport::TransportConfig config;
@@ -95,17 +121,7 @@ TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
   EXPECT_EQ(last.batches_dropped, 0);
   EXPECT_EQ(last.batches_lost, 0);
   EXPECT_GE(last.episodes, 60);
-  for (int id = 0; id < 2; ++id) {
-    const auto& list = episodes[id];
-    ASSERT_GE(list.size(), 30u) << "actor " << id << " reported too few episodes\n" << logs;
-    EXPECT_GT(list.back().policy_version, list.front().policy_version)
-        << "actor " << id << " did not pick up new weights";
-    EXPECT_GT(list.back().policy_version, 0);
-    for (std::size_t i = 1; i < list.size(); ++i) {
-      EXPECT_EQ(list[i].episode_id, list[i - 1].episode_id + 1) << "an episode report was lost";
-      EXPECT_GE(list[i].policy_version, list[i - 1].policy_version) << "policy went backwards";
-    }
-  }
+  for (int id = 0; id < 2; ++id) expect_actor_learning(id, episodes[id], logs);
   for (auto& actor : actors) {
     const int status = actor->terminate();
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << actor->log();
@@ -115,15 +131,7 @@ TEST_P(TrainingSystem, SimTwoActorsLearnerAndLoggerTrainTogether) {
 
   // The logger received the system's channels through the same transport and wrote them.
   const auto heartbeat_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(3);
-  const auto written = [&](const std::string& channel) -> std::int64_t {
-    if (!logged) return 0;
-    for (int i = 0; i < logged->num_channels; ++i) {
-      if (logged->channel[static_cast<std::size_t>(i)] == channel) {
-        return logged->written[static_cast<std::size_t>(i)];
-      }
-    }
-    return 0;
-  };
+  const auto written = [&](const std::string& channel) { return written_on(logged, channel); };
   const auto episodes_seen = static_cast<std::int64_t>(episodes[0].size() + episodes[1].size());
   // A heartbeat after everything else stopped counts everything the monitor saw.
   const auto logged_all = [&] {
