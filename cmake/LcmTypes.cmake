@@ -20,9 +20,9 @@ function(auvrl_lcm_types)
   add_custom_command(
     OUTPUT ${hpp_files}
     COMMAND ${LCM_GEN} --cpp --cpp-hpath ${gen_dir}/cpp ${lcm_abs_files}
-    # Refuse array lengths the bytes cannot hold before allocating (see the script).
-    COMMAND ${CMAKE_COMMAND} "-DFILES=${hpp_files}" -P ${PROJECT_SOURCE_DIR}/cmake/LcmBoundArrays.cmake
-    DEPENDS ${lcm_abs_files} ${PROJECT_SOURCE_DIR}/cmake/LcmBoundArrays.cmake
+    # Refuse array and string lengths the bytes cannot hold (see the script).
+    COMMAND ${CMAKE_COMMAND} "-DFILES=${hpp_files}" -P ${PROJECT_SOURCE_DIR}/cmake/LcmBoundLengths.cmake
+    DEPENDS ${lcm_abs_files} ${PROJECT_SOURCE_DIR}/cmake/LcmBoundLengths.cmake
     COMMENT "lcm-gen --cpp: ${ARG_PACKAGE}"
     VERBATIM)
   add_custom_target(${ARG_TARGET}_gen DEPENDS ${hpp_files})

@@ -2,10 +2,13 @@
 // (fuzz/lcm.dict) with the real encoders, so the seeds are what the processes really exchange:
 //   build-fuzz/bin/fuzz_make_corpus fuzz
 // Deterministic: the same build writes the same bytes.
+#include <algorithm>
+#include <array>
 #include <auvrl_lcm/episode_report_t.hpp>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/learner_stats_t.hpp>
 #include <auvrl_lcm/logger_heartbeat_t.hpp>
+#include <auvrl_lcm/mission_t.hpp>
 #include <auvrl_lcm/policy_summary_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
 #include <auvrl_lcm/sim_heartbeat_t.hpp>
@@ -25,6 +28,7 @@
 #include "fuzz/fuzz_util.hpp"
 #include "learner/checkpoint.hpp"
 #include "logger/event_log.hpp"
+#include "sim/vehicle_model.hpp"
 
 using namespace auvrl;
 namespace fs = std::filesystem;
@@ -303,6 +307,72 @@ void file_seeds() {
   for (const char* p : {"paper", "fast"}) {
     write_seed("fuzz_run_config", p, file_bytes(config_dir + "/presets/" + p + ".yaml"));
   }
+  for (const char* m : {"test1", "test2", "fault", "tour", "tour_fault"}) {
+    write_seed("fuzz_mission_yaml", m, file_bytes(config_dir + "/missions/" + m + ".yaml"));
+  }
+}
+
+/// What Nessie VII (vehicle 0) reports at `position_ned_m`, moving forward at 1 m/s with every
+/// thruster giving thrust_n.
+auvrl_lcm::vehicle_state_t state_message(const VehicleFacts& vehicle, std::int64_t seq,
+                                         const std::array<double, 3>& position_ned_m,
+                                         double thrust_n) {
+  auvrl_lcm::vehicle_state_t m{};
+  m.vehicle_id = 0;
+  m.seq = seq;
+  m.step_count = seq;
+  m.sim_time_s = 0.1 * static_cast<double>(seq);
+  for (int i = 0; i < 3; ++i) m.position_ned_m[i] = position_ned_m[static_cast<std::size_t>(i)];
+  m.velocity_body_mps[0] = 1.0;
+  m.vehicle_name = vehicle.name;
+  m.vehicle_file_crc32 = static_cast<std::int32_t>(vehicle.file_crc32);
+  m.num_thrusters = static_cast<std::int8_t>(vehicle.num_thrusters());
+  m.thrust_realised_n.assign(static_cast<std::size_t>(vehicle.num_thrusters()), thrust_n);
+  return m;
+}
+
+/// A mission for vehicle 0: a mission file's text without its vehicle: line.
+auvrl_lcm::mission_t mission_message(const std::string& file) {
+  std::ifstream in(file);
+  auvrl_lcm::mission_t m{};
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("vehicle:", 0) != 0) m.yaml += line + "\n";
+  }
+  return m;
+}
+
+void controller_seeds() {
+  const std::string config_dir = AUVRL_CONFIG_DIR;
+  const VehicleFacts vehicle =
+      sim::load_vehicle_file(config_dir + "/vehicles/nessie7.yaml").facts();
+  // Selector: 0 a state, 1 a mission.
+  Bytes run;
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0)));
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 1, {0.1, 0, 5}, 20)));
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 2, {0.2, 0.1, 5.1}, 0)));
+  fuzz::append_record(run, 1, fuzz::encode(mission_message(config_dir + "/missions/tour.yaml")));
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 3, {0.3, 0.1, 5.1}, 20)));
+  write_seed("fuzz_controller_node", "states_new_mission", run);
+
+  Bytes bodies;  // fingerprints added by the target (selector bit 7)
+  fuzz::append_record(bodies, 0x80, body(fuzz::encode(state_message(vehicle, 0, {7, 6, 10}, 0))));
+  fuzz::append_record(bodies, 0x80, body(fuzz::encode(state_message(vehicle, 1, {7, 6, 10}, NAN))));
+  fuzz::append_record(bodies, 0x81,
+                      body(fuzz::encode(mission_message(config_dir + "/missions/test2.yaml"))));
+  write_seed("fuzz_controller_node", "bodies", bodies);
+
+  // 2026-11-29: a vehicle_name length of INT32_MIN made lcm-gen's decoder read 2 GB past the
+  // message (cmake/LcmBoundLengths.cmake); the length field follows the name's fixed-size fields.
+  Bytes state = fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0));
+  const Bytes name_length = {0, 0, 0, static_cast<std::uint8_t>(vehicle.name.size() + 1)};
+  auto at = std::search(state.begin(), state.end(), name_length.begin(), name_length.end());
+  if (at == state.end()) throw std::runtime_error("no vehicle_name in the state's encoding");
+  const Bytes int32_min = {0x80, 0, 0, 0};
+  std::copy(int32_min.begin(), int32_min.end(), at);
+  Bytes regression;
+  fuzz::append_record(regression, 0, state);
+  write_seed("fuzz_controller_node", "regression_string_length_int32_min", regression);
 }
 
 template <class Msg>
@@ -333,6 +403,7 @@ void lcm_dictionary() {
   dict_entry<auvrl_lcm::learner_stats_t>(out, "learner_stats_t");
   dict_entry<auvrl_lcm::sim_heartbeat_t>(out, "sim_heartbeat_t");
   dict_entry<auvrl_lcm::logger_heartbeat_t>(out, "logger_heartbeat_t");
+  dict_entry<auvrl_lcm::mission_t>(out, "mission_t");
   out << "i32_max=\"\\x7f\\xff\\xff\\xff\"\n"
          "i32_min=\"\\x80\\x00\\x00\\x00\"\n"
          "i32_minus1=\"\\xff\\xff\\xff\\xff\"\n"
@@ -363,6 +434,7 @@ int main(int argc, char** argv) {
     logger_seeds(config);
     event_log_seeds();
     file_seeds();
+    controller_seeds();
     lcm_dictionary();
   } catch (const std::exception& e) {
     std::cerr << "fuzz_make_corpus: " << e.what() << "\n";

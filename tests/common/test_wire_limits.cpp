@@ -1,16 +1,19 @@
 // Messages whose array lengths claim more elements than their bytes hold (a 60-byte message
 // claiming 2^31 transitions, a 2 GB network, 2^31 channel names) are refused by decode_exact
 // before the decoder allocates anything large: lcm-gen's decoder resized first and checked
-// after, so one datagram could make a process zero gigabytes (found by the fuzzers; fixed by
-// cmake/LcmBoundArrays.cmake). Its own executable: it replaces operator new to see the largest
-// request.
+// after, so one datagram could make a process zero gigabytes. Strings whose length is below
+// one are refused too. Both found by the fuzzers, fixed by cmake/LcmBoundLengths.cmake. Its own
+// executable: it replaces operator new to see the largest request.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/logger_heartbeat_t.hpp>
+#include <auvrl_lcm/mission_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
 #include <auvrl_lcm/thruster_cmd_t.hpp>
+#include <auvrl_lcm/vehicle_state_t.hpp>
 #include <cstdlib>
 #include <new>
 
@@ -33,8 +36,10 @@ void* operator new(std::size_t n) {
   if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+// Not inlined: gcc would otherwise see free() on what its own operator new returned and warn
+// (-Wmismatched-new-delete), not knowing this operator new is malloc.
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }
+[[gnu::noinline]] void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -113,6 +118,63 @@ TEST(WireLimits, LoggerHeartbeatClaimingHugeChannelCountIsRefusedBeforeAllocatin
   const auto [ok, largest] = decode_tracked<auvrl_lcm::logger_heartbeat_t>(bytes);
   EXPECT_FALSE(ok);
   EXPECT_LT(largest, kSmall);
+}
+
+/// Where the length of the string `text` begins in `bytes` (LCM: a big-endian int32 of the
+/// string's size plus its terminating NUL, then the characters).
+std::size_t string_length_offset(const Bytes& bytes, const std::string& text) {
+  Bytes pattern(4);
+  put_i32(pattern, 0, static_cast<std::int32_t>(text.size() + 1));
+  pattern.insert(pattern.end(), text.begin(), text.end());
+  const auto at = std::search(bytes.begin(), bytes.end(), pattern.begin(), pattern.end());
+  EXPECT_NE(at, bytes.end()) << "no string '" << text << "' in the encoding";
+  return static_cast<std::size_t>(at - bytes.begin());
+}
+
+TEST(WireLimits, StringLengthsBelowOneAreRefused) {
+  // lcm-gen 1.3.1 checks a string's length only against the bytes left, then copies length - 1
+  // characters: a length of 0 or -5 made the copy throw (length_error, caught), and INT32_MIN
+  // wrapped to 2^31 - 1, so that one datagram made the receiver read 2 GB past its buffer
+  // (found by fuzz_controller_node; fixed by cmake/LcmBoundLengths.cmake).
+  auvrl_lcm::vehicle_state_t state{};
+  state.vehicle_name = "nessie7";
+  const Bytes good_state = encode(state);
+  const std::size_t name_at = string_length_offset(good_state, "nessie7");
+  auvrl_lcm::mission_t mission{};
+  mission.yaml = "name: m";
+  const Bytes good_mission = encode(mission);
+  const std::size_t yaml_at = string_length_offset(good_mission, "name: m");
+  auvrl_lcm::logger_heartbeat_t heartbeat{};  // a string array
+  heartbeat.num_channels = 1;
+  heartbeat.channel = {"EPISODE"};
+  heartbeat.received = heartbeat.written = heartbeat.throttled = {3};
+  const Bytes good_heartbeat = encode(heartbeat);
+  const std::size_t channel_at = string_length_offset(good_heartbeat, "EPISODE");
+  for (const std::int32_t length : {INT32_MIN, -5, 0}) {
+    Bytes bad_heartbeat = good_heartbeat;
+    put_i32(bad_heartbeat, channel_at, length);
+    EXPECT_FALSE(decode_tracked<auvrl_lcm::logger_heartbeat_t>(bad_heartbeat).first)
+        << "channel name length " << length;
+    Bytes bad_state = good_state;
+    put_i32(bad_state, name_at, length);
+    auto [ok, largest] = decode_tracked<auvrl_lcm::vehicle_state_t>(bad_state);
+    EXPECT_FALSE(ok) << "vehicle_name length " << length;
+    EXPECT_LT(largest, kSmall) << "vehicle_name length " << length;
+    Bytes bad_mission = good_mission;
+    put_i32(bad_mission, yaml_at, length);
+    std::tie(ok, largest) = decode_tracked<auvrl_lcm::mission_t>(bad_mission);
+    EXPECT_FALSE(ok) << "yaml length " << length;
+    EXPECT_LT(largest, kSmall) << "yaml length " << length;
+  }
+  auvrl_lcm::vehicle_state_t got_state;
+  EXPECT_TRUE(transport::decode_exact(good_state.data(), good_state.size(), got_state));
+  EXPECT_EQ(got_state.vehicle_name, "nessie7");
+  auvrl_lcm::mission_t got_mission;
+  EXPECT_TRUE(transport::decode_exact(good_mission.data(), good_mission.size(), got_mission));
+  EXPECT_EQ(got_mission.yaml, "name: m");
+  auvrl_lcm::logger_heartbeat_t got_heartbeat;
+  EXPECT_TRUE(transport::decode_exact(good_heartbeat.data(), good_heartbeat.size(), got_heartbeat));
+  EXPECT_EQ(got_heartbeat.channel, heartbeat.channel);
 }
 
 TEST(WireLimits, RealMessagesStillDecode) {
