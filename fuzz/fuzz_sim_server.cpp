@@ -1,9 +1,10 @@
-// auv_sim's input: SIM_CMD_<id>, SIM_RESET_<id> and SIM_FAULT_<id> messages as raw bytes,
-// published on the in-process transport and handled by SimServer (the code auv_sim runs), for
-// two vehicles (ids 0 and 1) of the real Nessie VII model in lockstep mode.
+// auv_sim's input: SIM_CMD_<id>, SIM_RESET_<id>, SIM_FAULT_<id> and SIM_CURRENT_<id> messages
+// as raw bytes, published on the in-process transport and handled by SimServer (the code auv_sim
+// runs), for two vehicles (ids 0 and 1) of the real Nessie VII model in lockstep mode.
 #include <auvrl_lcm/thruster_cmd_t.hpp>
 #include <auvrl_lcm/thruster_fault_t.hpp>
 #include <auvrl_lcm/vehicle_reset_t.hpp>
+#include <auvrl_lcm/water_current_t.hpp>
 
 #include "common/channels.hpp"
 #include "fuzz/fuzz_util.hpp"
@@ -23,11 +24,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // Vehicle ids a channel may name: served, served, just past the range, far out.
   static const int kIds[4] = {0, 1, 2, 99999};
   for (const fuzz::Record& r : fuzz::read_records(data, size)) {
-    const int kind = (r.selector & 0x7F) % 3;
-    const int id = kIds[((r.selector & 0x7F) / 3) % 4];
+    // Selector: bit 6 a current, else kind (0 command, 1 reset, 2 fault) + 3 * id index.
+    const int kind = (r.selector & 0x40) != 0 ? 3 : (r.selector & 0x3F) % 3;
+    const int id = kIds[((r.selector & 0x3F) / 3) % 4];
     std::vector<std::uint8_t> bytes;
     std::string channel;
-    if (kind == 0) {
+    if (kind == 3) {
+      channel = channels::sim_current(id);
+      bytes = fuzz::message_bytes<auvrl_lcm::water_current_t>(r);
+    } else if (kind == 0) {
       channel = channels::sim_command(id);
       bytes = fuzz::message_bytes<auvrl_lcm::thruster_cmd_t>(r);
     } else if (kind == 1) {

@@ -16,6 +16,7 @@
 #include <auvrl_lcm/thruster_fault_t.hpp>
 #include <auvrl_lcm/vehicle_reset_t.hpp>
 #include <auvrl_lcm/vehicle_state_t.hpp>
+#include <auvrl_lcm/water_current_t.hpp>
 #include <auvrl_lcm/weights_request_t.hpp>
 #include <cmath>
 #include <filesystem>
@@ -85,7 +86,8 @@ auvrl_lcm::thruster_fault_t fault_message(int vehicle_id) {
 }
 
 void sim_server_seeds() {
-  // Selector: kind (0 command, 1 reset, 2 fault) + 3 * id index (ids 0, 1, 2, 99999).
+  // Selector: kind (0 command, 1 reset, 2 fault) + 3 * id index (ids 0, 1, 2, 99999); bit 6
+  // instead: a current.
   Bytes episode;
   fuzz::append_record(episode, 1, fuzz::encode(reset_message(0)));
   for (int k = 2; k < 5; ++k)
@@ -106,6 +108,16 @@ void sim_server_seeds() {
   fuzz::append_record(bodies, 0x80 | 0, body(fuzz::encode(command_message(0, 2, NAN))));
   fuzz::append_record(bodies, 0x80 | 2, body(fuzz::encode(fault_message(0))));
   write_seed("fuzz_sim_server", "bodies", bodies);
+
+  Bytes current;  // selector bit 6: a current
+  auvrl_lcm::water_current_t flow{};
+  flow.current_constant_ned_mps[0] = 0.3;
+  fuzz::append_record(current, 1, fuzz::encode(reset_message(0)));
+  fuzz::append_record(current, 0x40, fuzz::encode(flow));
+  fuzz::append_record(current, 0, fuzz::encode(command_message(0, 2, 10)));
+  flow.current_constant_ned_mps[1] = NAN;
+  fuzz::append_record(current, 0x40, fuzz::encode(flow));
+  write_seed("fuzz_sim_server", "reset_current_step", current);
 }
 
 auvrl_lcm::experience_batch_t experience(int state_dim, int action_dim, int n, int actor_id,
@@ -404,6 +416,7 @@ void lcm_dictionary() {
   dict_entry<auvrl_lcm::sim_heartbeat_t>(out, "sim_heartbeat_t");
   dict_entry<auvrl_lcm::logger_heartbeat_t>(out, "logger_heartbeat_t");
   dict_entry<auvrl_lcm::mission_t>(out, "mission_t");
+  dict_entry<auvrl_lcm::water_current_t>(out, "water_current_t");
   out << "i32_max=\"\\x7f\\xff\\xff\\xff\"\n"
          "i32_min=\"\\x80\\x00\\x00\\x00\"\n"
          "i32_minus1=\"\\xff\\xff\\xff\\xff\"\n"
