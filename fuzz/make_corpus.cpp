@@ -8,6 +8,7 @@
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/learner_stats_t.hpp>
 #include <auvrl_lcm/logger_heartbeat_t.hpp>
+#include <auvrl_lcm/mission_status_t.hpp>
 #include <auvrl_lcm/mission_t.hpp>
 #include <auvrl_lcm/policy_summary_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
@@ -387,6 +388,47 @@ void controller_seeds() {
   write_seed("fuzz_controller_node", "regression_string_length_int32_min", regression);
 }
 
+/// The controller's MISSION_STATUS after `elapsed_s` of a mission of `count` way-points.
+auvrl_lcm::mission_status_t status_message(double elapsed_s, int index, int count) {
+  auvrl_lcm::mission_status_t m{};
+  m.mission_name = "tour_fault";
+  m.controller = "policy";
+  m.waypoint_index = index;
+  m.waypoint_count = count;
+  m.goal_ned_m[0] = 6;
+  m.goal_ned_m[1] = 4;
+  m.goal_ned_m[2] = 8;
+  m.elapsed_s = elapsed_s;
+  m.supervisor_state = auvrl_lcm::mission_status_t::STATE_ACTIVE;
+  return m;
+}
+
+void mission_record_seeds() {
+  const std::string config_dir = AUVRL_CONFIG_DIR;
+  const VehicleFacts vehicle =
+      sim::load_vehicle_file(config_dir + "/vehicles/nessie7.yaml").facts();
+  // Selector: 0 state, 1 command, 2 status, 3 fault, 4 current. A reset state, then the
+  // controller's: a command answered by a state, its status, the way to the first way-point
+  // [6, 4, 8] and a hold there, the mission's fault at 40 s and a current.
+  Bytes run;
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0)));
+  fuzz::append_record(run, 4, fuzz::encode(auvrl_lcm::water_current_t{}));
+  for (int k = 1; k <= 8; ++k) {
+    fuzz::append_record(run, 1, fuzz::encode(command_message(0, k, 20)));
+    const double f = k / 8.0;
+    fuzz::append_record(run, 0,
+                        fuzz::encode(state_message(vehicle, k, {6 * f, 4 * f, 5 + 3 * f}, 20)));
+    fuzz::append_record(run, 2, fuzz::encode(status_message(0.1 * (k - 1), 0, 6)));
+  }
+  auvrl_lcm::vehicle_state_t late = state_message(vehicle, 400, {6, 4, 8}, 0);
+  fuzz::append_record(run, 0, fuzz::encode(late));
+  fuzz::append_record(run, 3, fuzz::encode(fault_message(0)));
+  auvrl_lcm::water_current_t flow{};
+  flow.current_constant_ned_mps[1] = 0.2;
+  fuzz::append_record(run, 4, fuzz::encode(flow));
+  write_seed("fuzz_mission_record", "reset_way_fault_current", run);
+}
+
 template <class Msg>
 void dict_entry(std::ostream& out, const char* name) {
   const auto hash = static_cast<std::uint64_t>(Msg::getHash());
@@ -448,6 +490,7 @@ int main(int argc, char** argv) {
     event_log_seeds();
     file_seeds();
     controller_seeds();
+    mission_record_seeds();
     lcm_dictionary();
   } catch (const std::exception& e) {
     std::cerr << "fuzz_make_corpus: " << e.what() << "\n";
