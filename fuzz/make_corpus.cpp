@@ -325,6 +325,13 @@ void file_seeds() {
   }
 }
 
+/// Nessie VII's facts (its name, file CRC and thrusters: what a state must announce).
+const VehicleFacts& nessie7() {
+  static const VehicleFacts facts =
+      sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml").facts();
+  return facts;
+}
+
 /// What Nessie VII (vehicle 0) reports at `position_ned_m`, moving forward at 1 m/s with every
 /// thruster giving thrust_n.
 auvrl_lcm::vehicle_state_t state_message(const VehicleFacts& vehicle, std::int64_t seq,
@@ -357,8 +364,7 @@ auvrl_lcm::mission_t mission_message(const std::string& file) {
 
 void controller_seeds() {
   const std::string config_dir = AUVRL_CONFIG_DIR;
-  const VehicleFacts vehicle =
-      sim::load_vehicle_file(config_dir + "/vehicles/nessie7.yaml").facts();
+  const VehicleFacts& vehicle = nessie7();
   // Selector: 0 a state, 1 a mission.
   Bytes run;
   fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0)));
@@ -376,7 +382,7 @@ void controller_seeds() {
   write_seed("fuzz_controller_node", "bodies", bodies);
 
   // 2026-11-29: a vehicle_name length of INT32_MIN made lcm-gen's decoder read 2 GB past the
-  // message (cmake/LcmBoundLengths.cmake); the length field follows the name's fixed-size fields.
+  // message (cmake/LcmBoundLengths.cmake); the length field is the 4 bytes before the name.
   Bytes state = fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0));
   const Bytes name_length = {0, 0, 0, static_cast<std::uint8_t>(vehicle.name.size() + 1)};
   auto at = std::search(state.begin(), state.end(), name_length.begin(), name_length.end());
@@ -404,9 +410,7 @@ auvrl_lcm::mission_status_t status_message(double elapsed_s, int index, int coun
 }
 
 void mission_record_seeds() {
-  const std::string config_dir = AUVRL_CONFIG_DIR;
-  const VehicleFacts vehicle =
-      sim::load_vehicle_file(config_dir + "/vehicles/nessie7.yaml").facts();
+  const VehicleFacts& vehicle = nessie7();
   // Selector: 0 state, 1 command, 2 status, 3 fault, 4 current. A reset state, then the
   // controller's: a command answered by a state, its status, the way to the first way-point
   // [6, 4, 8] and a hold there, the mission's fault at 40 s and a current.
@@ -420,8 +424,7 @@ void mission_record_seeds() {
                         fuzz::encode(state_message(vehicle, k, {6 * f, 4 * f, 5 + 3 * f}, 20)));
     fuzz::append_record(run, 2, fuzz::encode(status_message(0.1 * (k - 1), 0, 6)));
   }
-  auvrl_lcm::vehicle_state_t late = state_message(vehicle, 400, {6, 4, 8}, 0);
-  fuzz::append_record(run, 0, fuzz::encode(late));
+  fuzz::append_record(run, 0, fuzz::encode(state_message(vehicle, 400, {6, 4, 8}, 0)));
   fuzz::append_record(run, 3, fuzz::encode(fault_message(0)));
   auvrl_lcm::water_current_t flow{};
   flow.current_constant_ned_mps[1] = 0.2;

@@ -47,26 +47,28 @@ ThrusterFaultAccommodation::ThrusterFaultAccommodation(const TaskConfig& task) :
 
 void ThrusterFaultAccommodation::reset() {
   const int n = task_.num_thrusters;
-  previous_command_ = realised_n_ = keep_ = command_ = rhs_ = spread_ = Eigen::VectorXd::Zero(n);
+  previous_command_ = realised_n_ = command_ = rhs_ = spread_ = Eigen::VectorXd::Zero(n);
   system_ = Eigen::MatrixXd::Zero(n, n);
   solver_ = Eigen::LDLT<Eigen::MatrixXd>(n);
   replica_delayed_n_ = replica_n_ = Eigen::VectorXd::Zero(n);
   moment_realised_replica_ = moment_replica_squared_ = Eigen::VectorXd::Zero(n);
   efficiency_ = Eigen::VectorXd::Ones(n);
-  dead_.assign(static_cast<std::size_t>(n), false);
+  keep_ = Eigen::VectorXd::Ones(n);
+  any_dead_ = false;
 }
 
 void ThrusterFaultAccommodation::apply(const Eigen::Ref<const StateVector>& state,
                                        ActionVector& action) {
-  estimate(state);
-  if (std::find(dead_.begin(), dead_.end(), true) != dead_.end()) redistribute(action);
+  if (estimate(state)) factorise();
+  if (any_dead_) redistribute(action);
 }
 
 // The replica steps as sim::step treats a command: the one-step delay, the lag toward the
 // delayed command, the slew limit. The state's previous action is the command that the
 // vehicle took one step ago, its realised thrust the replica's thrust after this update.
-void ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& state) {
+bool ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& state) {
   const ThrusterDynamics& td = task_.thruster_dynamics;
+  bool newly_dead = false;
   previous_action_from_state(task_, state, previous_command_);
   realised_thrust_from_state(task_, state, realised_n_);
   const double min_squared = kMinReplicaThrustN * kMinReplicaThrustN;
@@ -85,24 +87,30 @@ void ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& s
     if (moment_replica_squared_[i] >= min_squared) {
       efficiency_[i] =
           std::clamp(moment_realised_replica_[i] / moment_replica_squared_[i], 0.0, 1.0);
-      if (efficiency_[i] < task_.fault_accommodation.dead_below) {
-        dead_[static_cast<std::size_t>(i)] = true;
+      if (keep_[i] != 0.0 && efficiency_[i] < task_.fault_accommodation.dead_below) {
+        keep_[i] = 0.0;
+        newly_dead = true;
       }
     }
   }
+  return newly_dead;
+}
+
+void ThrusterFaultAccommodation::factorise() {
+  any_dead_ = true;
+  system_.noalias() = keep_.asDiagonal() * wrench_gram_ * keep_.asDiagonal();
+  system_.diagonal().array() += damping_;
+  solver_.compute(system_);
 }
 
 void ThrusterFaultAccommodation::redistribute(ActionVector& action) {
-  const int n = task_.num_thrusters;
-  for (int i = 0; i < n; ++i) keep_[i] = dead_[static_cast<std::size_t>(i)] ? 0.0 : 1.0;
   command_ = action.cast<double>();  // normalised: the scale cancels
-  system_.noalias() = keep_.asDiagonal() * wrench_gram_ * keep_.asDiagonal();
-  system_.diagonal().array() += damping_;
   rhs_.noalias() = wrench_gram_ * command_;
   rhs_ = keep_.cwiseProduct(rhs_) + damping_ * keep_.cwiseProduct(command_);
-  solver_.compute(system_);
   spread_ = solver_.solve(rhs_);
-  for (int i = 0; i < n; ++i) action[i] = static_cast<float>(std::clamp(spread_[i], -1.0, 1.0));
+  for (int i = 0; i < task_.num_thrusters; ++i) {
+    action[i] = static_cast<float>(std::clamp(spread_[i], -1.0, 1.0));
+  }
 }
 
 }  // namespace auvrl::task

@@ -4,7 +4,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <vector>
 
 #include "common/task/task.hpp"
 
@@ -42,7 +41,7 @@ class ThrusterFaultAccommodation {
   /// Each thruster's estimated efficiency (1 until enough thrust was asked of it).
   const Eigen::VectorXd& efficiency_estimate() const { return efficiency_; }
   /// Whether thruster i (0-based) counts as dead.
-  bool dead(int i) const { return dead_[static_cast<std::size_t>(i)]; }
+  bool dead(int i) const { return keep_[i] == 0.0; }
   // The constants it runs with (the C export writes them out).
   const Eigen::MatrixXd& wrench_gram() const { return wrench_gram_; }  ///< B'B, n x n
   double damping() const { return damping_; }                          ///< lambda
@@ -51,7 +50,11 @@ class ThrusterFaultAccommodation {
   double slew_step_n() const { return slew_step_n_; }      ///< the replica's largest step, N
 
  private:
-  void estimate(const Eigen::Ref<const StateVector>& state);
+  /// Updates the efficiency estimates; true if a thruster was found dead this step.
+  bool estimate(const Eigen::Ref<const StateVector>& state);
+  /// The damped least-squares system for the thrusters now dead, factorised (it changes only
+  /// when one more dies).
+  void factorise();
   void redistribute(ActionVector& action);
 
   TaskConfig task_;
@@ -63,11 +66,12 @@ class ThrusterFaultAccommodation {
   Eigen::VectorXd replica_delayed_n_, replica_n_;  ///< a healthy thruster's command and thrust
   Eigen::VectorXd moment_realised_replica_, moment_replica_squared_;
   Eigen::VectorXd efficiency_;
-  std::vector<bool> dead_;
+  Eigen::VectorXd keep_;                 ///< E: 0 for a thruster found dead, 1 otherwise
+  bool any_dead_ = false;                ///< some entry of keep_ is 0
+  Eigen::MatrixXd system_;               ///< E B'B E + lambda I
+  Eigen::LDLT<Eigen::MatrixXd> solver_;  ///< its factorisation
   // Scratch, sized once: a step allocates nothing.
-  Eigen::VectorXd previous_command_, realised_n_, keep_, command_, rhs_, spread_;
-  Eigen::MatrixXd system_;
-  Eigen::LDLT<Eigen::MatrixXd> solver_;
+  Eigen::VectorXd previous_command_, realised_n_, command_, rhs_, spread_;
 };
 
 }  // namespace auvrl::task
