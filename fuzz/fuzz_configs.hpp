@@ -35,4 +35,11 @@ inline learner::LearnerNodeConfig small_reproducible_learner_config() {
   return c;
 }
 
+/// The training run fuzz_training_monitor follows: two actors, its roles started in this order
+/// as processes kMonitorFirstPid, kMonitorFirstPid + 1, ...
+inline constexpr const char* kMonitorRoles[] = {"logger", "learner", "sim0",
+                                                "sim1",   "actor0",  "actor1"};
+inline constexpr int kMonitorActors = 2;
+inline constexpr int kMonitorFirstPid = 10;
+
 }  // namespace auvrl::fuzz

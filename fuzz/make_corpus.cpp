@@ -432,6 +432,85 @@ void mission_record_seeds() {
   write_seed("fuzz_mission_record", "reset_way_fault_current", run);
 }
 
+void actor_lockstep_seeds() {
+  const VehicleFacts& vehicle = nessie7();
+  // Selector bit 0 clear: the state made the answer (seq and vehicle id filled in); bit 1 set:
+  // its own vehicle identity kept. A reset answered, then steps down towards 8 m depth.
+  Bytes episode;
+  for (int k = 0; k <= 20; ++k) {
+    const double f = k / 20.0;
+    fuzz::append_record(episode, 0,
+                        fuzz::encode(state_message(vehicle, k, {f, f, 5 + 3 * f}, 10 * f)));
+  }
+  write_seed("fuzz_actor_lockstep", "reset_and_steps", episode);
+  // The simulator blows up mid-episode; then one naming another vehicle, kept as it is.
+  Bytes blow_up;
+  fuzz::append_record(blow_up, 0, fuzz::encode(state_message(vehicle, 0, {0, 0, 5}, 0)));
+  auvrl_lcm::vehicle_state_t broken = state_message(vehicle, 1, {0, 0, 5}, 0);
+  broken.status = auvrl_lcm::vehicle_state_t::STATUS_NON_FINITE;
+  broken.velocity_body_mps[0] = std::nan("");
+  fuzz::append_record(blow_up, 0, fuzz::encode(broken));
+  write_seed("fuzz_actor_lockstep", "blow_up", blow_up);
+  Bytes other;
+  auvrl_lcm::vehicle_state_t stranger = state_message(vehicle, 0, {0, 0, 5}, 0);
+  stranger.vehicle_name = "another";
+  fuzz::append_record(other, 2, fuzz::encode(stranger));
+  write_seed("fuzz_actor_lockstep", "another_vehicle", other);
+}
+
+void training_monitor_seeds() {
+  // Selector: 0 episode, 1 learner statistics, 2 simulator heartbeat, 3 logger heartbeat,
+  // 4 a role restarted, 5 the clock advanced. The run's roles are processes 10..15 (logger,
+  // learner, sim0, sim1, actor0, actor1): a few seconds of a run, actor 1 discarding its
+  // episodes, sim0 restarted as process 20 (a late heartbeat of its former process 12), and a
+  // heartbeat and an episode from outside the run.
+  const int pid = fuzz::kMonitorFirstPid;
+  const auto heartbeat = [](int from, double steps_per_s) {
+    auvrl_lcm::sim_heartbeat_t h{};
+    h.pid = from;
+    h.vehicle_name = "nessie7";
+    h.num_vehicles = 1;
+    h.lockstep = true;
+    h.steps_per_s = steps_per_s;
+    return fuzz::encode(h);
+  };
+  const auto report = [](int actor, bool success, std::int8_t reason) {
+    auvrl_lcm::episode_report_t e{};
+    e.actor_id = actor;
+    e.success = success;
+    e.beta_m = 0.5;
+    e.end_reason = reason;
+    return fuzz::encode(e);
+  };
+  Bytes run;
+  auvrl_lcm::logger_heartbeat_t logger{};
+  logger.pid = pid;
+  fuzz::append_record(run, 3, fuzz::encode(logger));
+  auvrl_lcm::learner_stats_t stats{};
+  stats.pid = pid + 1;
+  stats.algo = "td3";
+  stats.updates = 1000;
+  stats.updates_per_s = 900;
+  for (int second = 0; second < 4; ++second) {
+    fuzz::append_record(run, 2, heartbeat(pid + 2, 1500));
+    fuzz::append_record(run, 2, heartbeat(pid + 3, 1400));
+    fuzz::append_record(run, 1, fuzz::encode(stats));
+    fuzz::append_record(run, 0,
+                        report(0, second % 2 == 0, auvrl_lcm::episode_report_t::END_REACHED));
+    fuzz::append_record(run, 0, report(1, false, auvrl_lcm::episode_report_t::END_BLOW_UP));
+    fuzz::append_record(run, 5, Bytes{10});
+  }
+  fuzz::append_record(run, 4, Bytes{2, 20, 0});  // sim0 restarted as process 20
+  fuzz::append_record(run, 2, heartbeat(pid + 2, 1500));
+  fuzz::append_record(run, 2, heartbeat(20, 1300));
+  fuzz::append_record(run, 2, heartbeat(99, 1e9));
+  fuzz::append_record(run, 0, report(7, true, auvrl_lcm::episode_report_t::END_REACHED));
+  fuzz::append_record(run, 5, Bytes{255});
+  fuzz::append_record(run, 2, heartbeat(pid + 3, 1400));
+  fuzz::append_record(run, 0, report(1, false, auvrl_lcm::episode_report_t::END_SIM_TIMEOUT));
+  write_seed("fuzz_training_monitor", "run_restart_foreign", run);
+}
+
 template <class Msg>
 void dict_entry(std::ostream& out, const char* name) {
   const auto hash = static_cast<std::uint64_t>(Msg::getHash());
@@ -494,6 +573,8 @@ int main(int argc, char** argv) {
     file_seeds();
     controller_seeds();
     mission_record_seeds();
+    training_monitor_seeds();
+    actor_lockstep_seeds();
     lcm_dictionary();
   } catch (const std::exception& e) {
     std::cerr << "fuzz_make_corpus: " << e.what() << "\n";

@@ -92,6 +92,8 @@ int Supervisor::alive_key(const Role& role) const {
 }
 
 void Supervisor::start(Role& role) {
+  // The replaced process's signs of life no longer count (nor does its entry stay).
+  if (role.proc) alive_by_pid_.erase(role.proc->pid());
   role.proc = starter_.start(role.spec.argv(role.restarts_s.size()), role.spec.log_path);
   // The new process is watched from its own first sign of life on.
   alive_by_pid_.erase(role.proc->pid());

@@ -9,11 +9,9 @@
 #include <auvrl_lcm/logger_heartbeat_t.hpp>
 #include <auvrl_lcm/policy_weights_t.hpp>
 #include <auvrl_lcm/sim_heartbeat_t.hpp>
-#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <optional>
 #include <stdexcept>
 
@@ -27,6 +25,7 @@
 #include "launcher/format.hpp"
 #include "launcher/run_directory.hpp"
 #include "launcher/telemetry.hpp"
+#include "launcher/training_monitor.hpp"
 
 namespace auvrl::launcher {
 
@@ -230,35 +229,6 @@ std::vector<RoleSpec> make_roles(const RunContext& ctx,
 
 namespace {
 
-/// The figures of the status line, gathered from the traffic.
-struct TrainingFigures {
-  std::deque<bool> recent_success;  ///< the last 100 episodes' outcomes
-  std::int64_t episodes_seen = 0;   ///< episode reports received by this invocation
-  double beta_m = 0;                ///< the newest goal radius, m
-  std::optional<auvrl_lcm::learner_stats_t> last_stats;
-  std::int64_t learner_episodes = 0;
-  std::map<int, double> sim_steps_per_s;  ///< by simulator process id
-  std::map<int, double> sim_heard_s;      ///< the last heartbeat by simulator process id, s
-  /// Per actor id: since when every episode it reported was discarded (blow-up or simulator
-  /// timeout: nothing sent to the learner), how many, and the last one's end reason.
-  struct Discarding {
-    double since_s = 0;
-    std::int64_t episodes = 0;
-    int last_reason = 0;
-  };
-  std::map<int, Discarding> discarding;
-
-  double success_rate() const {
-    const auto successes = std::count(recent_success.begin(), recent_success.end(), true);
-    return recent_success.empty() ? 0.0 : static_cast<double>(successes) / recent_success.size();
-  }
-  double steps_per_s() const {
-    double sum = 0;
-    for (const auto& entry : sim_steps_per_s) sum += entry.second;
-    return sum;
-  }
-};
-
 /// One training stage: the transport, the supervised processes and what they report.
 class TrainingSession {
  public:
@@ -292,11 +262,12 @@ class TrainingSession {
   void print_summary(const SupervisionOutcome& outcome);
   /// A simulator that serves another vehicle than the run's is a fault (vehicle_fault_).
   void check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& heartbeat);
-  /// Follows each actor's run of discarded episodes.
-  void note_discarded(const auvrl_lcm::episode_report_t& report);
   /// An actor that has discarded every episode for run.discard_fault_s while its simulator
   /// answers heartbeats: the run learns nothing (a hung simulator is the supervisor's).
   std::optional<std::string> discarding_actor() const;
+  /// True when the monitor took the message; says so once when the first message from
+  /// outside the run arrives.
+  bool heard(Heard heard, const std::string& channel, const std::string& from);
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -306,7 +277,8 @@ class TrainingSession {
   ChildProcessStarter starter_;
   TrainingTelemetry telemetry_;
   Supervisor supervisor_;
-  TrainingFigures figures_;
+  TrainingMonitor monitor_{ctx_.actors, clock_};
+  bool said_foreign_ = false;
   std::unique_ptr<BestPolicyKeeper> best_;
   SnapshotReviewer snapshots_{snapshot_dir(ctx_.run_dir)};
   std::optional<std::string> vehicle_fault_;
@@ -326,35 +298,34 @@ void TrainingSession::subscribe() {
   transport_ = transport::make_transport(config);
   transport::subscribe<auvrl_lcm::episode_report_t>(
       *transport_, channels::kEpisode,
-      [this](const std::string&, const auvrl_lcm::episode_report_t& e) {
+      [this](const std::string& channel, const auvrl_lcm::episode_report_t& e) {
+        if (!heard(monitor_.take_episode(e), channel, fmt::format("actor id {}", e.actor_id)))
+          return;
         supervisor_.heard_from_actor(e.actor_id);
-        ++figures_.episodes_seen;
-        figures_.beta_m = e.beta_m;
-        figures_.recent_success.push_back(e.success);
-        if (figures_.recent_success.size() > 100) figures_.recent_success.pop_front();
-        note_discarded(e);
         telemetry_.episodes.add(wall_s(), e);
       });
   transport::subscribe<auvrl_lcm::learner_stats_t>(
       *transport_, channels::kLearnerStats,
-      [this](const std::string&, const auvrl_lcm::learner_stats_t& s) {
+      [this](const std::string& channel, const auvrl_lcm::learner_stats_t& s) {
+        if (!heard(monitor_.take_learner_stats(s), channel, fmt::format("process {}", s.pid)))
+          return;
         supervisor_.heard_from_pid(s.pid);
-        figures_.last_stats = s;
-        figures_.learner_episodes = s.episodes;
         telemetry_.learner.add(wall_s(), s);
       });
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *transport_, channels::kSimHeartbeat,
-      [this](const std::string&, const auvrl_lcm::sim_heartbeat_t& h) {
+      [this](const std::string& channel, const auvrl_lcm::sim_heartbeat_t& h) {
+        if (!heard(monitor_.take_sim_heartbeat(h), channel, fmt::format("process {}", h.pid)))
+          return;
         supervisor_.heard_from_pid(h.pid);
-        figures_.sim_steps_per_s[h.pid] = h.steps_per_s;
-        figures_.sim_heard_s[h.pid] = clock_.now_s();
         check_simulated_vehicle(h);
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
       *transport_, channels::kLoggerHeartbeat,
-      [this](const std::string&, const auvrl_lcm::logger_heartbeat_t& h) {
-        supervisor_.heard_from_pid(h.pid);
+      [this](const std::string& channel, const auvrl_lcm::logger_heartbeat_t& h) {
+        if (heard(monitor_.take_logger_heartbeat(h), channel, fmt::format("process {}", h.pid))) {
+          supervisor_.heard_from_pid(h.pid);
+        }
       });
   // Reproducible mode evaluates the learner's snapshots instead of the broadcast weights.
   if (ctx_.rc.run.reproducible) return;
@@ -367,7 +338,8 @@ void TrainingSession::start_processes() {
   const std::vector<std::string> transport_args = transport::transport_arguments(ctx_.rc.transport);
   for (RoleSpec& role : make_roles(ctx_, transport_args)) supervisor_.add(std::move(role));
   const fs::path proc_dir = fs::path(ctx_.run_dir) / "processes";
-  supervisor_.on_start([proc_dir](const std::string& name, int pid) {
+  supervisor_.on_start([this, proc_dir](const std::string& name, int pid) {
+    monitor_.started(name, pid);
     // PID in the run's namespace, for tools and tests started in that namespace.
     std::ofstream((proc_dir / (name + ".pid")).string()) << pid << "\n";
   });
@@ -408,14 +380,15 @@ void TrainingSession::evaluate_newest_weights() {
 }
 
 std::string TrainingSession::status_line(double eta_s) const {
-  const double updates_per_s = figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0;
+  const auto& stats = monitor_.learner_stats();
+  const double updates_per_s = stats ? stats->updates_per_s : 0.0;
   const std::string best_text =
       best_->has_best() ? fmt::format("{}/{}", best_->best().reached, best_->best().episodes) : "-";
   return fmt::format(
       "episodes {}  success(100) {:.0f}%  beta {:.2f} m  env {:.0f} steps/s  updates {:.0f}/s  "
       "best {}  elapsed {}  left {}",
-      figures_.learner_episodes, 100 * figures_.success_rate(), figures_.beta_m,
-      figures_.steps_per_s(), updates_per_s, best_text, format_duration(wall_s()),
+      stats ? stats->episodes : 0, 100 * monitor_.success_rate(), monitor_.beta_m(),
+      monitor_.env_steps_per_s(), updates_per_s, best_text, format_duration(wall_s()),
       format_duration(eta_s));
 }
 
@@ -427,16 +400,17 @@ double TrainingSession::left_s() const {
   const RunConfig& rc = ctx_.rc;
   if (!rc.run.reproducible && rc.run.max_train_s > 0) return rc.run.max_train_s - wall_s();
   double left = -1;
-  if (rc.learner_max_episodes > 0 && figures_.learner_episodes > 0 && figures_.episodes_seen > 0) {
-    left = static_cast<double>(rc.learner_max_episodes - figures_.learner_episodes) *
-           ((clock_.now_s() - start_s_) / static_cast<double>(figures_.episodes_seen));
+  const auto& stats = monitor_.learner_stats();
+  const std::int64_t learner_episodes = stats ? stats->episodes : 0;
+  if (rc.learner_max_episodes > 0 && learner_episodes > 0 && monitor_.episodes_seen() > 0) {
+    left = static_cast<double>(rc.learner_max_episodes - learner_episodes) *
+           ((clock_.now_s() - start_s_) / static_cast<double>(monitor_.episodes_seen()));
   }
   // Reproducible mode: the updates still to do at the learner's rate (the sooner end counts).
-  const double updates_per_s = figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0;
+  const double updates_per_s = stats ? stats->updates_per_s : 0.0;
   if (rc.run.reproducible && rc.learner_max_updates > 0 && updates_per_s > 0) {
     const double by_updates =
-        std::max<double>(
-            0.0, static_cast<double>(rc.learner_max_updates - figures_.last_stats->updates)) /
+        std::max<double>(0.0, static_cast<double>(rc.learner_max_updates - stats->updates)) /
         updates_per_s;
     left = left < 0 ? by_updates : std::min(left, by_updates);
   }
@@ -447,12 +421,13 @@ std::optional<std::string> TrainingSession::show_progress() {
   if (clock_.now_s() < next_progress_s_) return std::nullopt;
   next_progress_s_ = clock_.now_s() + 1.0;
   const double eta_s = left_s();
+  const auto& stats = monitor_.learner_stats();
   ProgressRow row{wall_s(),
-                  figures_.learner_episodes,
-                  figures_.success_rate(),
-                  figures_.beta_m,
-                  figures_.steps_per_s(),
-                  figures_.last_stats ? figures_.last_stats->updates_per_s : 0.0,
+                  stats ? stats->episodes : 0,
+                  monitor_.success_rate(),
+                  monitor_.beta_m(),
+                  monitor_.env_steps_per_s(),
+                  stats ? stats->updates_per_s : 0.0,
                   0.0};
   if (best_->has_best()) {
     row.best_suite_success = static_cast<double>(best_->best().reached) / best_->best().episodes;
@@ -478,34 +453,27 @@ void TrainingSession::check_simulated_vehicle(const auvrl_lcm::sim_heartbeat_t& 
   }
 }
 
-void TrainingSession::note_discarded(const auvrl_lcm::episode_report_t& report) {
-  const auto reason = static_cast<task::EndReason>(report.end_reason);
-  if (reason != task::EndReason::kBlowUp && reason != task::EndReason::kSimTimeout) {
-    figures_.discarding.erase(report.actor_id);
-    return;
-  }
-  auto [entry, first] = figures_.discarding.try_emplace(report.actor_id);
-  if (first) entry->second.since_s = clock_.now_s();
-  ++entry->second.episodes;
-  entry->second.last_reason = report.end_reason;
+std::optional<std::string> TrainingSession::discarding_actor() const {
+  const std::optional<DiscardingRun> run = monitor_.discarding_actor(ctx_.rc.run.discard_fault_s);
+  if (!run) return std::nullopt;
+  return fmt::format(
+      "actor{} discarded every episode for {:.0f} s ({} episodes, the last ended by {}) while its "
+      "simulator answers: nothing reaches the learner (see {}/processes/actor{}.log and "
+      "sim{}.log)",
+      run->actor_id, run->for_s, run->episodes,
+      eval::end_reason_name(static_cast<task::EndReason>(run->last_end_reason)), ctx_.run_dir,
+      run->actor_id, run->actor_id);
 }
 
-std::optional<std::string> TrainingSession::discarding_actor() const {
-  const double now = clock_.now_s();
-  for (const auto& [actor, run] : figures_.discarding) {
-    if (now - run.since_s < ctx_.rc.run.discard_fault_s) continue;
-    const int sim_pid = supervisor_.pid("sim" + std::to_string(actor));
-    const auto heard = figures_.sim_heard_s.find(sim_pid);
-    if (heard == figures_.sim_heard_s.end() || now - heard->second > 3.0) continue;
-    return fmt::format(
-        "actor{} discarded every episode for {:.0f} s ({} episodes, the last ended by {}) while "
-        "its simulator answers: nothing reaches the learner (see {}/processes/actor{}.log and "
-        "sim{}.log)",
-        actor, now - run.since_s, run.episodes,
-        eval::end_reason_name(static_cast<task::EndReason>(run.last_reason)), ctx_.run_dir, actor,
-        actor);
+bool TrainingSession::heard(Heard heard, const std::string& channel, const std::string& from) {
+  if (heard == Heard::kTaken) return true;
+  if (heard == Heard::kForeign && !said_foreign_) {
+    said_foreign_ = true;
+    out_ << (tty_ ? "\n" : "") << "auvrl train: ignoring " << channel << " from " << from
+         << ", which is not one of this run's (another system on the same bus?); "
+            "further ones are counted in the summary\n";
   }
-  return std::nullopt;
+  return false;
 }
 
 SupervisionOutcome TrainingSession::supervise_pass() {
@@ -557,6 +525,10 @@ void TrainingSession::print_summary(const SupervisionOutcome& outcome) {
        << "  checkpoints  " << (run_dir / "checkpoints").string() << "\n"
        << "  policy       " << (run_dir / "policy.nn").string() << best_text << "\n"
        << "  logs         " << (run_dir / "logs").string() << "\n";
+  if (monitor_.foreign() + monitor_.malformed() > 0) {
+    out_ << "  ignored      " << monitor_.foreign() << " messages from outside the run, "
+         << monitor_.malformed() << " with figures that are not finite\n";
+  }
   if (outcome.exit_code != 0 && outcome.resumable) {
     out_ << "  continue it: auvrl train --resume " << run_dir.string() << "\n";
   }
