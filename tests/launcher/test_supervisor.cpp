@@ -8,16 +8,10 @@
 #include <vector>
 
 #include "launcher/supervisor.hpp"
+#include "tests/launcher/manual_clock.hpp"
 
 namespace auvrl::launcher {
 namespace {
-
-/// Time that moves only when the test says so.
-class FakeClock : public Clock {
- public:
-  double now_s() const override { return t_s; }
-  double t_s = 0;
-};
 
 /// What the test controls and observes of one fake process.
 struct FakeState {
@@ -115,7 +109,7 @@ class SupervisorTest : public ::testing::Test {
     starter.newest(name)->status = status;
   }
 
-  FakeClock clock;
+  ManualClock clock;
   FakeStarter starter;
   std::ostringstream out;
   std::unique_ptr<Supervisor> supervisor;

@@ -8,15 +8,10 @@
 
 #include "common/task/task.hpp"
 #include "launcher/training_monitor.hpp"
+#include "tests/launcher/manual_clock.hpp"
 
 namespace auvrl::launcher {
 namespace {
-
-class ManualClock : public Clock {
- public:
-  double now_s() const override { return t_s; }
-  double t_s = 0;
-};
 
 auvrl_lcm::sim_heartbeat_t sim_heartbeat(int pid, double steps_per_s) {
   auvrl_lcm::sim_heartbeat_t h{};
