@@ -267,7 +267,7 @@ class TrainingSession {
   std::optional<std::string> discarding_actor() const;
   /// True when the monitor took the message; says so once when the first message from
   /// outside the run arrives.
-  bool heard(Heard heard, const std::string& channel, const std::string& from);
+  bool heard(Heard verdict, const std::string& channel, const std::string& from);
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -465,9 +465,9 @@ std::optional<std::string> TrainingSession::discarding_actor() const {
       run->actor_id, run->actor_id);
 }
 
-bool TrainingSession::heard(Heard heard, const std::string& channel, const std::string& from) {
-  if (heard == Heard::kTaken) return true;
-  if (heard == Heard::kForeign && !said_foreign_) {
+bool TrainingSession::heard(Heard verdict, const std::string& channel, const std::string& from) {
+  if (verdict == Heard::kTaken) return true;
+  if (verdict == Heard::kForeign && !said_foreign_) {
     said_foreign_ = true;
     out_ << (tty_ ? "\n" : "") << "auvrl train: ignoring " << channel << " from " << from
          << ", which is not one of this run's (another system on the same bus?); "
