@@ -17,7 +17,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     sign_policies(ctx.run_dir, key, out);  // a stopped run's policies are usable too
     return trained.exit_code;
   }
-  const std::optional<std::string> selected = select_policy(ctx.run_dir, *trained.best);
+  const std::optional<std::string> selected = select_policy(
+      ctx.run_dir, *trained.best, {ctx.model, ctx.rc.task, ctx.rc.finetune.selection_seed}, out);
   if (!selected) {
     out << "auvrl train: no policy was written; nothing to fine-tune or evaluate\n";
     return 1;

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <utility>
 #include <vector>
 
@@ -23,18 +24,56 @@ namespace auvrl::launcher {
 
 namespace fs = std::filesystem;
 
-std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best) {
-  std::string policy_path = (fs::path(run_dir) / "policy.nn").string();
-  if (fs::exists(best.best_path())) {
-    // The last policy may be worse than the best seen: compare them on the quick evaluation.
-    try {
-      if (best.best_ranks_above(policy_path)) policy_path = best.best_path();
-    } catch (const std::exception&) {
-      policy_path = best.best_path();
-    }
+namespace {
+
+/// The policy of the two with fewer failures on the selection draw; `preferred` on a tie or
+/// when they cannot be counted.
+std::string fewer_failures(const std::string& preferred, const std::string& other,
+                           const SelectionDraw& draw, std::ostream& out) {
+  const std::vector<std::uint8_t> preferred_bytes = nn::read_file(preferred);
+  if (preferred_bytes == nn::read_file(other)) return preferred;  // the same weights
+  try {
+    const nn::Mlp preferred_net = nn::network_from_bytes(preferred_bytes, 1);
+    const nn::Mlp other_net = nn::network_from_bytes(nn::read_file(other), 1);
+    // The two counts at once: training has ended, and the CPUs are free.
+    auto other_count = std::async(std::launch::async, [&] {
+      return tuning::suite_failures(draw.model, draw.task, draw.seed, other_net);
+    });
+    const int preferred_failures =
+        tuning::suite_failures(draw.model, draw.task, draw.seed, preferred_net);
+    const int other_failures = other_count.get();
+    const bool switch_over = other_failures < preferred_failures;
+    out << fmt::format(
+        "auvrl train: selected {}: flips and blow-ups in the robustness suite at seed {}: {} {}, "
+        "{} {}\n",
+        fs::path(switch_over ? other : preferred).filename().string(), draw.seed,
+        fs::path(preferred).filename().string(), preferred_failures,
+        fs::path(other).filename().string(), other_failures);
+    return switch_over ? other : preferred;
+  } catch (const std::exception& e) {
+    out << "auvrl train: failures not counted (" << e.what() << "); selected " << preferred << "\n";
+    return preferred;
   }
-  if (!fs::exists(policy_path)) return std::nullopt;
-  return policy_path;
+}
+
+}  // namespace
+
+std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best,
+                                         const SelectionDraw& draw, std::ostream& out) {
+  const std::string last = (fs::path(run_dir) / "policy.nn").string();
+  if (!fs::exists(best.best_path())) {
+    if (!fs::exists(last)) return std::nullopt;
+    return last;
+  }
+  // The last policy may be worse than the best seen: compare them on the quick evaluation.
+  bool best_above = true;
+  try {
+    best_above = best.best_ranks_above(last);
+  } catch (const std::exception&) {
+    return best.best_path();  // the last one cannot be read
+  }
+  const std::string preferred = best_above ? best.best_path() : last;
+  return fewer_failures(preferred, best_above ? last : best.best_path(), draw, out);
 }
 
 namespace {

@@ -16,9 +16,21 @@
 
 namespace auvrl::launcher {
 
+/// Where the trained policies' failures are counted: the robustness suite drawn at `seed`, a
+/// validation draw of the pipeline's own (finetune.selection_seed).
+struct SelectionDraw {
+  const sim::VehicleModel& model;
+  const task::TaskConfig& task;
+  std::uint64_t seed = 7890;
+};
+
 /// The trained policy to go on with: policy.nn, or policy_best.nn when the best seen ranks
-/// above the last one (or the last one cannot be read). Nothing when neither file exists.
-std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best);
+/// above the last one on the quick evaluation (or the last one cannot be read); but of two
+/// different files, the one with fewer failures (flips, blow-ups) on the selection draw, which
+/// the quick evaluation's few way-points can miss (a TD3 snapshot that flips on deep dives).
+/// Says what it counted on out. Nothing when neither file exists.
+std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best,
+                                         const SelectionDraw& draw, std::ostream& out);
 
 /// What the fine-tuning stage needs besides the policy.
 struct FinetuneStageInput {

@@ -100,7 +100,8 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "searches from the trained policy, each with its own seed; the kept one passes the "
           "most robustness groups at selection_seed");
   t.field("selection_seed", &C::selection_seed, "not 1",
-          "the robustness suite's draw that chooses among the candidates");
+          "the robustness suite's draw that chooses among the candidates, and on which the "
+          "trained policies' flips are counted (select)");
   return t;
 }
 

@@ -18,6 +18,15 @@ eval::EvaluationConfig suite_config(const task::TaskConfig& task, std::uint64_t 
   return config;
 }
 
+/// Refuses the evaluation's own draw for a choice.
+void require_validation_seed(std::uint64_t seed, const char* who) {
+  if (seed == eval::EvaluationConfig{}.seed) {
+    throw std::invalid_argument(std::string(who) + "'s robustness suite at seed " +
+                                std::to_string(seed) +
+                                ": that is the evaluation's own draw; choose on another seed");
+  }
+}
+
 }  // namespace
 
 std::uint64_t candidate_seed(std::uint64_t run_seed, int index) {
@@ -28,10 +37,7 @@ std::uint64_t candidate_seed(std::uint64_t run_seed, int index) {
 SuiteSelector::SuiteSelector(const sim::VehicleModel& model, const task::TaskConfig& task,
                              std::uint64_t seed, int episodes_per_group)
     : model_(model), task_(task), seed_(seed), episodes_per_group_(episodes_per_group) {
-  if (seed == eval::EvaluationConfig{}.seed) {
-    throw std::invalid_argument("the candidates' robustness suite at seed " + std::to_string(seed) +
-                                ": that is the evaluation's own draw; choose on another seed");
-  }
+  require_validation_seed(seed, "the candidates");
   agent::PidController pid(model, agent::pid_gains_for(model).gains);
   pid_groups_ =
       eval::run_robustness(model, suite_config(task_, seed_), pid, episodes_per_group_, seed_, "")
@@ -58,6 +64,17 @@ std::size_t choose_candidate(const std::vector<int>& groups_passing) {
     if (groups_passing[i] > groups_passing[best]) best = i;
   }
   return best;
+}
+
+int suite_failures(const sim::VehicleModel& model, const task::TaskConfig& task, std::uint64_t seed,
+                   const nn::Mlp& policy, int episodes_per_group) {
+  require_validation_seed(seed, "the selection");
+  agent::PolicyController controller(policy, task);
+  const eval::RobustnessResult result = eval::run_robustness(
+      model, suite_config(task, seed), controller, episodes_per_group, seed, "");
+  int failures = 0;
+  for (const eval::GroupMetrics& group : result.groups) failures += group.flips + group.blow_ups;
+  return failures;
 }
 
 }  // namespace auvrl::tuning

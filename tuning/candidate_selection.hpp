@@ -1,8 +1,9 @@
-// Choosing among fine-tuning candidates: several searches from the same trained policy, each
-// with a seed of its own (its way-points and its perturbations), and the one whose kept weights
-// pass the most groups of the robustness suite against the PID baseline is kept. The suite is
-// drawn at a validation seed of the fine-tuning's own (finetune.selection_seed), never at the
-// evaluation's: the choice sees the suite's kinds of conditions, not the draws it is scored on.
+// Choosing on a validation draw of the robustness suite: among fine-tuning candidates (several
+// searches from the same trained policy, each with a seed of its own), the one whose kept
+// weights pass the most groups against the PID baseline; between the trained policies (the last
+// and the best seen), the one that flips less. The suite is drawn at a validation seed of the
+// pipeline's own (finetune.selection_seed), never at the evaluation's: the choice sees the
+// suite's kinds of conditions, not the draws it is scored on.
 #pragma once
 
 #include <cstdint>
@@ -47,5 +48,12 @@ class SuiteSelector {
 /// The candidate to keep: the most groups passing, ties to the earliest. Throws
 /// std::invalid_argument when there is none.
 std::size_t choose_candidate(const std::vector<int>& groups_passing);
+
+/// The failures (flips and blow-ups) of the policy, driving as the task says, over the
+/// robustness suite drawn at `seed`: a validation draw of the pipeline's own. Throws
+/// std::invalid_argument when seed is the evaluation's own draw, as SuiteSelector does.
+int suite_failures(const sim::VehicleModel& model, const task::TaskConfig& task, std::uint64_t seed,
+                   const nn::Mlp& policy,
+                   int episodes_per_group = eval::kRobustnessEpisodesPerGroup);
 
 }  // namespace auvrl::tuning

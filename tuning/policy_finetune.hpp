@@ -116,8 +116,9 @@ struct FinetuneConfig {
   /// those that pass the most robustness groups against the PID at selection_seed
   /// (tuning/candidate_selection.hpp). 1: one search, no choice.
   int candidates = 1;
-  /// The robustness suite's draw that chooses among the candidates: a validation draw of the
-  /// fine-tuning's own, never the evaluation's (seed 1).
+  /// The robustness suite's draw that chooses among the candidates, and on which the pipeline's
+  /// select stage counts the trained policies' flips: a validation draw of its own, never the
+  /// evaluation's (seed 1).
   std::uint64_t selection_seed = 7890;
 
   /// Throws std::invalid_argument naming the first setting out of range.
