@@ -36,6 +36,10 @@ int main(int argc, char** argv) {
   cmd.option("types-dir", &types_dir, "directory of the .lcm files (names types in the summary)");
   cmd.option("queue-capacity", &config.queue_capacity,
              "messages the transport may hold between polls");
+  cmd.option("max-channels", &config.max_channels,
+             "channels counted each on its own; further ones are logged and counted together "
+             "as " +
+                 logger::kOtherChannels);
   transport::add_transport_options(cmd, transport_config);
   transport_config.dds.role = "logger";
   try {

@@ -57,6 +57,10 @@ Logger::Logger(transport::Transport& transport, LoggerConfig config)
       !(config_.heartbeat_period_s > 0.0)) {
     throw std::invalid_argument("max file size, flush period and heartbeat period must be > 0");
   }
+  if (config_.max_channels < 1) {
+    throw std::invalid_argument("max channels must be >= 1, not " +
+                                std::to_string(config_.max_channels));
+  }
   std::vector<ThrottleRule> rules = config_.throttles;
   rules.push_back(kDefaultPolicyThrottle);
   for (const ThrottleRule& rule : rules) {
@@ -89,6 +93,16 @@ double Logger::throttle_interval(const std::string& channel) const {
 ChannelCounts& Logger::channel(const std::string& name) {
   const auto it = channel_index_.find(name);
   if (it != channel_index_.end()) return channels_[it->second];
+  if (channels_.size() >= static_cast<std::size_t>(config_.max_channels)) {
+    // Beyond the limit: one shared entry, never throttled (its channels differ).
+    const auto other = channel_index_.find(kOtherChannels);
+    if (other != channel_index_.end()) return channels_[other->second];
+    channel_index_.emplace(kOtherChannels, channels_.size());
+    ChannelCounts counts;
+    counts.channel = kOtherChannels;
+    channels_.push_back(std::move(counts));
+    return channels_.back();
+  }
   channel_index_.emplace(name, channels_.size());
   ChannelCounts counts;
   counts.channel = name;

@@ -43,7 +43,14 @@ struct LoggerConfig {
   std::vector<ThrottleRule> throttles;
   /// Messages LCM may hold between two polls (received by its thread, not yet handled).
   int queue_capacity = 100000;
+  /// Channels counted each on its own (in the heartbeat and the summary); the messages of
+  /// further ones are still logged, unthrottled, and counted together under
+  /// kOtherChannels, so that a flood of names cannot grow the logger or its heartbeat.
+  int max_channels = 1024;
 };
+
+/// The one entry that counts the channels beyond LoggerConfig::max_channels.
+inline const std::string kOtherChannels = "(other channels)";
 
 /// The built-in throttle: policy weights (large, after every update) at most every 10 s.
 inline const ThrottleRule kDefaultPolicyThrottle{channels::kPolicyWeights, 10.0};

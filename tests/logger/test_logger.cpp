@@ -211,6 +211,37 @@ TEST_F(LoggerTest, RotatesBySizeWithoutLosingMessages) {
   EXPECT_EQ(count_log(dir_)["DATA"], 400);
 }
 
+TEST_F(LoggerTest, ChannelsBeyondTheLimitAreLoggedAndCountedTogether) {
+  LoggerConfig config;
+  config.dir = dir_;
+  config.max_channels = 10;
+  config.throttles = {{"FLOOD_.*", 100.0}};  // would throttle them, one by one
+  Logger logger(*transport_, config);
+  for (int i = 0; i < 500; ++i) {
+    publish("FLOOD_" + std::to_string(i), 8);
+    if (i % 50 == 0) poll_all(logger);
+  }
+  publish("FLOOD_0", 8);  // a channel counted on its own keeps its throttle
+  poll_all(logger);
+  ASSERT_EQ(logger.channels().size(), 11u);
+  const ChannelCounts* other = find_channel(logger, kOtherChannels);
+  ASSERT_NE(other, nullptr);
+  // The logger's own heartbeat and FLOOD_0..FLOOD_8 fill the ten.
+  EXPECT_EQ(other->received, 491);
+  EXPECT_EQ(other->written, 491);
+  EXPECT_EQ(other->throttled, 0);
+  EXPECT_EQ(find_channel(logger, "FLOOD_0")->throttled, 1);
+  const auto hb = logger.heartbeat();
+  EXPECT_EQ(hb.num_channels, 11);
+  logger.finish(nullptr);
+  const auto logged = count_log(dir_);
+  std::int64_t flood = 0;
+  for (const auto& [channel, count] : logged) flood += channel.rfind("FLOOD_", 0) == 0 ? count : 0;
+  EXPECT_EQ(flood, 500);  // every distinct channel's message is in the log
+  config.max_channels = 0;
+  EXPECT_THROW(Logger(*transport_, config), std::invalid_argument);
+}
+
 TEST_F(LoggerTest, FlushPeriodPutsEventsOnDiskWhileRunning) {
   LoggerConfig config;
   config.dir = dir_;
