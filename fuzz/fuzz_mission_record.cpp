@@ -18,17 +18,6 @@
 
 using namespace auvrl;
 
-namespace {
-
-/// Decodes the record as Msg (with its fingerprint put in front when the selector asks).
-template <class Msg>
-bool decode(const fuzz::Record& r, Msg& msg) {
-  const std::vector<std::uint8_t> bytes = fuzz::message_bytes<Msg>(r);
-  return transport::decode_exact(bytes.data(), bytes.size(), msg);
-}
-
-}  // namespace
-
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const VehicleFacts facts =
       sim::load_vehicle_file(std::string(AUVRL_CONFIG_DIR) + "/vehicles/nessie7.yaml").facts();
@@ -41,21 +30,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // Selector: 0 state, 1 command, 2 status, 3 fault, 4 current.
     switch ((r.selector & 0x7F) % 5) {
       case 0:
-        if (auvrl_lcm::vehicle_state_t m; decode(r, m)) recorder.add_state(m, wall_s += 0.1);
+        if (auvrl_lcm::vehicle_state_t m; fuzz::decode_record(r, m))
+          recorder.add_state(m, wall_s += 0.1);
         break;
       case 1:
-        if (auvrl_lcm::thruster_cmd_t m; decode(r, m)) recorder.add_command(m);
+        if (auvrl_lcm::thruster_cmd_t m; fuzz::decode_record(r, m)) recorder.add_command(m);
         break;
       case 2:
-        if (auvrl_lcm::mission_status_t m; decode(r, m)) recorder.add_status(m);
+        if (auvrl_lcm::mission_status_t m; fuzz::decode_record(r, m)) recorder.add_status(m);
         break;
       case 3:
-        if (auvrl_lcm::thruster_fault_t m; decode(r, m)) {
+        if (auvrl_lcm::thruster_fault_t m; fuzz::decode_record(r, m)) {
           events.add_fault(m, recorder.mission_time_s(), "SIM_FAULT_0");
         }
         break;
       default:
-        if (auvrl_lcm::water_current_t m; decode(r, m)) {
+        if (auvrl_lcm::water_current_t m; fuzz::decode_record(r, m)) {
           events.add_current(m, recorder.mission_time_s(), "SIM_CURRENT_0");
         }
     }

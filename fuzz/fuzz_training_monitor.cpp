@@ -25,13 +25,6 @@ class InputClock : public launcher::Clock {
   double t_s = 0;
 };
 
-/// Decodes the record as Msg (with its fingerprint put in front when the selector asks).
-template <class Msg>
-bool decode(const fuzz::Record& r, Msg& msg) {
-  const std::vector<std::uint8_t> bytes = fuzz::message_bytes<Msg>(r);
-  return transport::decode_exact(bytes.data(), bytes.size(), msg);
-}
-
 /// A control record: restart role bytes[0] as process bytes[1..2] (little-endian).
 void restart(const fuzz::Record& r, launcher::TrainingMonitor& monitor) {
   fuzz::InputReader in(r.bytes.data(), r.bytes.size());
@@ -67,16 +60,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // 4 a role restarted, 5 the clock advanced by bytes[0] tenths of a second.
     switch ((r.selector & 0x7F) % 6) {
       case 0:
-        if (auvrl_lcm::episode_report_t m; decode(r, m)) monitor.take_episode(m);
+        if (auvrl_lcm::episode_report_t m; fuzz::decode_record(r, m)) monitor.take_episode(m);
         break;
       case 1:
-        if (auvrl_lcm::learner_stats_t m; decode(r, m)) monitor.take_learner_stats(m);
+        if (auvrl_lcm::learner_stats_t m; fuzz::decode_record(r, m)) monitor.take_learner_stats(m);
         break;
       case 2:
-        if (auvrl_lcm::sim_heartbeat_t m; decode(r, m)) monitor.take_sim_heartbeat(m);
+        if (auvrl_lcm::sim_heartbeat_t m; fuzz::decode_record(r, m)) monitor.take_sim_heartbeat(m);
         break;
       case 3:
-        if (auvrl_lcm::logger_heartbeat_t m; decode(r, m)) monitor.take_logger_heartbeat(m);
+        if (auvrl_lcm::logger_heartbeat_t m; fuzz::decode_record(r, m))
+          monitor.take_logger_heartbeat(m);
         break;
       case 4:
         restart(r, monitor);

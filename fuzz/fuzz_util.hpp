@@ -75,6 +75,14 @@ std::vector<std::uint8_t> message_bytes(const Record& r) {
   return out;
 }
 
+/// Decodes the record as Msg (with its fingerprint put in front when the selector asks), as a
+/// subscription decodes what it receives; false when it does not decode.
+template <class Msg>
+bool decode_record(const Record& r, Msg& msg) {
+  const std::vector<std::uint8_t> bytes = message_bytes<Msg>(r);
+  return transport::decode_exact(bytes.data(), bytes.size(), msg);
+}
+
 /// Appends one record to a seed input (the generator uses it).
 inline void append_record(std::vector<std::uint8_t>& out, std::uint8_t selector,
                           const std::vector<std::uint8_t>& bytes) {
