@@ -30,11 +30,12 @@ namespace {
 /// when they cannot be counted.
 std::string fewer_failures(const std::string& preferred, const std::string& other,
                            const SelectionDraw& draw, std::ostream& out) {
-  const std::vector<std::uint8_t> preferred_bytes = nn::read_file(preferred);
-  if (preferred_bytes == nn::read_file(other)) return preferred;  // the same weights
   try {
+    const std::vector<std::uint8_t> preferred_bytes = nn::read_file(preferred);
+    const std::vector<std::uint8_t> other_bytes = nn::read_file(other);
+    if (preferred_bytes == other_bytes) return preferred;  // the same weights
     const nn::Mlp preferred_net = nn::network_from_bytes(preferred_bytes, 1);
-    const nn::Mlp other_net = nn::network_from_bytes(nn::read_file(other), 1);
+    const nn::Mlp other_net = nn::network_from_bytes(other_bytes, 1);
     // The two counts at once: training has ended, and the CPUs are free.
     auto other_count = std::async(std::launch::async, [&] {
       return tuning::suite_failures(draw.model, draw.task, draw.seed, other_net);
