@@ -265,9 +265,9 @@ class TrainingSession {
   /// An actor that has discarded every episode for run.discard_fault_s while its simulator
   /// answers heartbeats: the run learns nothing (a hung simulator is the supervisor's).
   std::optional<std::string> discarding_actor() const;
-  /// True when the monitor took the message; says so once when the first message from
-  /// outside the run arrives.
-  bool heard(Heard verdict, const std::string& channel, const std::string& from);
+  /// True when the monitor took the message; says so when the first message from outside the
+  /// run arrives (sender: "process" or "actor id", and its number).
+  bool heard(Heard verdict, const std::string& channel, const char* sender, int sender_id);
 
   const RunContext& ctx_;
   std::ostream& out_;
@@ -278,7 +278,6 @@ class TrainingSession {
   TrainingTelemetry telemetry_;
   Supervisor supervisor_;
   TrainingMonitor monitor_{ctx_.actors, clock_};
-  bool said_foreign_ = false;
   std::unique_ptr<BestPolicyKeeper> best_;
   SnapshotReviewer snapshots_{snapshot_dir(ctx_.run_dir)};
   std::optional<std::string> vehicle_fault_;
@@ -299,31 +298,28 @@ void TrainingSession::subscribe() {
   transport::subscribe<auvrl_lcm::episode_report_t>(
       *transport_, channels::kEpisode,
       [this](const std::string& channel, const auvrl_lcm::episode_report_t& e) {
-        if (!heard(monitor_.take_episode(e), channel, fmt::format("actor id {}", e.actor_id)))
-          return;
+        if (!heard(monitor_.take_episode(e), channel, "actor id", e.actor_id)) return;
         supervisor_.heard_from_actor(e.actor_id);
         telemetry_.episodes.add(wall_s(), e);
       });
   transport::subscribe<auvrl_lcm::learner_stats_t>(
       *transport_, channels::kLearnerStats,
       [this](const std::string& channel, const auvrl_lcm::learner_stats_t& s) {
-        if (!heard(monitor_.take_learner_stats(s), channel, fmt::format("process {}", s.pid)))
-          return;
+        if (!heard(monitor_.take_learner_stats(s), channel, "process", s.pid)) return;
         supervisor_.heard_from_pid(s.pid);
         telemetry_.learner.add(wall_s(), s);
       });
   transport::subscribe<auvrl_lcm::sim_heartbeat_t>(
       *transport_, channels::kSimHeartbeat,
       [this](const std::string& channel, const auvrl_lcm::sim_heartbeat_t& h) {
-        if (!heard(monitor_.take_sim_heartbeat(h), channel, fmt::format("process {}", h.pid)))
-          return;
+        if (!heard(monitor_.take_sim_heartbeat(h), channel, "process", h.pid)) return;
         supervisor_.heard_from_pid(h.pid);
         check_simulated_vehicle(h);
       });
   transport::subscribe<auvrl_lcm::logger_heartbeat_t>(
       *transport_, channels::kLoggerHeartbeat,
       [this](const std::string& channel, const auvrl_lcm::logger_heartbeat_t& h) {
-        if (heard(monitor_.take_logger_heartbeat(h), channel, fmt::format("process {}", h.pid))) {
+        if (heard(monitor_.take_logger_heartbeat(h), channel, "process", h.pid)) {
           supervisor_.heard_from_pid(h.pid);
         }
       });
@@ -465,11 +461,12 @@ std::optional<std::string> TrainingSession::discarding_actor() const {
       run->actor_id, run->actor_id);
 }
 
-bool TrainingSession::heard(Heard verdict, const std::string& channel, const std::string& from) {
+bool TrainingSession::heard(Heard verdict, const std::string& channel, const char* sender,
+                            int sender_id) {
   if (verdict == Heard::kTaken) return true;
-  if (verdict == Heard::kForeign && !said_foreign_) {
-    said_foreign_ = true;
-    out_ << (tty_ ? "\n" : "") << "auvrl train: ignoring " << channel << " from " << from
+  if (verdict == Heard::kForeign && monitor_.foreign() == 1) {  // the first one
+    out_ << (tty_ ? "\n" : "") << "auvrl train: ignoring " << channel << " from " << sender << " "
+         << sender_id
          << ", which is not one of this run's (another system on the same bus?); "
             "further ones are counted in the summary\n";
   }

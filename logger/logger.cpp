@@ -91,22 +91,17 @@ double Logger::throttle_interval(const std::string& channel) const {
 }
 
 ChannelCounts& Logger::channel(const std::string& name) {
-  const auto it = channel_index_.find(name);
+  // Beyond max_channels, new channels share one entry, never throttled (its channels differ).
+  const bool alone = channels_.size() < static_cast<std::size_t>(config_.max_channels);
+  auto it = channel_index_.find(name);
+  if (it == channel_index_.end() && !alone) it = channel_index_.find(kOtherChannels);
   if (it != channel_index_.end()) return channels_[it->second];
-  if (channels_.size() >= static_cast<std::size_t>(config_.max_channels)) {
-    // Beyond the limit: one shared entry, never throttled (its channels differ).
-    const auto other = channel_index_.find(kOtherChannels);
-    if (other != channel_index_.end()) return channels_[other->second];
-    channel_index_.emplace(kOtherChannels, channels_.size());
-    ChannelCounts counts;
-    counts.channel = kOtherChannels;
-    channels_.push_back(std::move(counts));
-    return channels_.back();
-  }
-  channel_index_.emplace(name, channels_.size());
+  const std::string& key = alone ? name : kOtherChannels;
+  channel_index_.emplace(key, channels_.size());
   ChannelCounts counts;
-  counts.channel = name;
-  counts.throttle_interval_s = throttle_interval(name);  // regexes run once per channel
+  counts.channel = key;
+  // Regexes run once per channel.
+  counts.throttle_interval_s = alone ? throttle_interval(name) : 0.0;
   channels_.push_back(std::move(counts));
   return channels_.back();
 }

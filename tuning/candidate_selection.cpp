@@ -18,6 +18,16 @@ eval::EvaluationConfig suite_config(const task::TaskConfig& task, std::uint64_t 
   return config;
 }
 
+/// The policy's groups on the suite drawn at seed, driving as the task says.
+std::vector<eval::GroupMetrics> policy_groups(const sim::VehicleModel& model,
+                                              const task::TaskConfig& task, std::uint64_t seed,
+                                              int episodes_per_group, const nn::Mlp& policy) {
+  agent::PolicyController controller(policy, task);
+  return eval::run_robustness(model, suite_config(task, seed), controller, episodes_per_group, seed,
+                              "")
+      .groups;
+}
+
 /// Refuses the evaluation's own draw for a choice.
 void require_validation_seed(std::uint64_t seed, const char* who) {
   if (seed == eval::EvaluationConfig{}.seed) {
@@ -45,10 +55,8 @@ SuiteSelector::SuiteSelector(const sim::VehicleModel& model, const task::TaskCon
 }
 
 std::vector<eval::GroupComparison> SuiteSelector::compare(const nn::Mlp& policy) const {
-  agent::PolicyController controller(policy, task_);
-  const eval::RobustnessResult result = eval::run_robustness(
-      model_, suite_config(task_, seed_), controller, episodes_per_group_, seed_, "");
-  return eval::compare_robustness(result.groups, pid_groups_);
+  return eval::compare_robustness(policy_groups(model_, task_, seed_, episodes_per_group_, policy),
+                                  pid_groups_);
 }
 
 int SuiteSelector::groups_passing(const nn::Mlp& policy) const {
@@ -69,11 +77,11 @@ std::size_t choose_candidate(const std::vector<int>& groups_passing) {
 int suite_failures(const sim::VehicleModel& model, const task::TaskConfig& task, std::uint64_t seed,
                    const nn::Mlp& policy, int episodes_per_group) {
   require_validation_seed(seed, "the selection");
-  agent::PolicyController controller(policy, task);
-  const eval::RobustnessResult result = eval::run_robustness(
-      model, suite_config(task, seed), controller, episodes_per_group, seed, "");
   int failures = 0;
-  for (const eval::GroupMetrics& group : result.groups) failures += group.flips + group.blow_ups;
+  for (const eval::GroupMetrics& group :
+       policy_groups(model, task, seed, episodes_per_group, policy)) {
+    failures += group.flips + group.blow_ups;
+  }
   return failures;
 }
 
