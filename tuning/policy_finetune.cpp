@@ -57,6 +57,22 @@ task::EpisodeRandomisation sensor_noise_only(task::EpisodeRandomisation randomis
   return randomisation;
 }
 
+/// A steep dive from the task's start (FinetuneConfig::dive_fraction): depth uniform in the
+/// lower half of what the region allows below the start, the horizontal offset uniform in the
+/// disc of radius dive_across_m; clamped to the region.
+Eigen::Vector3d dive_goal(const task::TaskConfig& task, const FinetuneConfig& config,
+                          std::mt19937_64& rng) {
+  const Eigen::Vector3d& start_ned_m = task.start_position_ned_m;
+  const double deepest_m = task.goal_max_ned_m.z();
+  const double from_m = start_ned_m.z() + 0.5 * std::max(0.0, deepest_m - start_ned_m.z());
+  const double radius_m = config.dive_across_m * std::sqrt(draw::unit(rng));
+  const double bearing_rad = (2.0 * draw::unit(rng) - 1.0) * kPi;
+  const double depth_m = from_m + (deepest_m - from_m) * draw::unit(rng);
+  const Eigen::Vector3d goal_ned_m(start_ned_m.x() + radius_m * std::cos(bearing_rad),
+                                   start_ned_m.y() + radius_m * std::sin(bearing_rad), depth_m);
+  return goal_ned_m.cwiseMax(task.goal_min_ned_m).cwiseMin(task.goal_max_ned_m);
+}
+
 }  // namespace
 
 void FinetuneConfig::validate() const {
@@ -97,6 +113,8 @@ void FinetuneConfig::validate() const {
   require(randomised_fraction >= 0 && randomised_fraction <= 1,
           "randomised_fraction must be in [0, 1]");
   require(noisy_fraction >= 0 && noisy_fraction <= 1, "noisy_fraction must be in [0, 1]");
+  require(dive_fraction >= 0 && dive_fraction <= 1, "dive_fraction must be in [0, 1]");
+  require(std::isfinite(dive_across_m) && dive_across_m > 0, "dive_across_m must be > 0");
   std::string key;
   const std::string what = randomise.check(key);
   require(what.empty(), "randomise." + key + " " + what);
@@ -122,6 +140,8 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   const int plain = config.episodes - randomised;
   const int noisy = static_cast<int>(std::lround(config.noisy_fraction * plain));
   int plain_so_far = 0;
+  std::mt19937_64 dive_rng = finetune_stream(seed, 0xD1BEu);
+  const int dives = static_cast<int>(std::lround(config.dive_fraction * plain));
   // Whether item i of n is one of the k spread evenly through them.
   const auto spread = [](int k, int i, int n) { return k > 0 && (i * k) / n != ((i + 1) * k) / n; };
   int faults = 0;
@@ -129,6 +149,11 @@ std::vector<FinetuneEpisode> finetune_episodes(const task::TaskConfig& task,
   for (int i = 0; i < config.episodes; ++i) {
     FinetuneEpisode e;
     e.goal_ned_m = task::sample_goal(task, rng);
+    if (!spread(randomised, i, config.episodes)) {
+      // Drawn for every plain way-point, so that turning dives on moves no other one.
+      const Eigen::Vector3d dive_ned_m = dive_goal(task, config, dive_rng);
+      if (spread(dives, plain_so_far, plain)) e.goal_ned_m = dive_ned_m;
+    }
     e.start.position_ned_m = task.start_position_ned_m;
     e.start.euler_rpy_rad = Eigen::Vector3d(0.0, 0.0, task.start_yaw_rad);
     const Eigen::Vector3d anywhere_ned_m = region_start(task, e.goal_ned_m, starts_rng);

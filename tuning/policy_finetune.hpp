@@ -65,6 +65,13 @@ struct FinetuneConfig {
   /// sensor_noise_scale, from a stream of its own. Noise on the faulted way-points as well
   /// would make them harder than the faults the fine-tuning is there to learn.
   double noisy_fraction = 0.0;
+  /// Of the way-points without randomised conditions, this share (spread through them) is a
+  /// steep dive from the task's start instead, from a stream of its own: depth in the lower
+  /// half of what the region allows below the start, and at most dive_across_m across. Drawn
+  /// uniformly from the region, such a dive is one way-point in twenty or so, and a policy that
+  /// pitches ever further nose-down there (the flip margin's price) is seldom priced for it.
+  double dive_fraction = 0.0;
+  double dive_across_m = 5.0;  ///< a dive's largest horizontal distance from its start, m
   /// Objective of one way-point, s: the time to within the reach radius (interpolated
   /// between control steps, so that braking a little later counts before it gains a whole
   /// step) plus hold_weight times the mean distance over the arrival step and the hold_steps

@@ -229,6 +229,43 @@ TEST(FinetuneEpisodes, NoiseTheShareAskedOfThePlainOnes) {
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
+// dive_fraction: that share of the plain way-points becomes a steep dive from the task's start
+// (the lower half of the depth below it, at most dive_across_m across); the others, the
+// headings and the randomised ones do not move.
+TEST(FinetuneEpisodes, DiveTheShareAskedOfThePlainOnes) {
+  FinetuneConfig c;
+  c.episodes = 20;
+  c.random_heading_fraction = 0.5;
+  c.randomised_fraction = 0.4;
+  c.randomise.fault_probability = 1.0;
+  const task::TaskConfig t = fast_task();
+  const auto drawn = finetune_episodes(t, c, 9);
+  c.dive_fraction = 0.25;
+  c.dive_across_m = 4.0;
+  const auto dived = finetune_episodes(t, c, 9);
+  ASSERT_EQ(dived.size(), drawn.size());
+  const double start_depth_m = t.start_position_ned_m.z();
+  const double from_m = start_depth_m + 0.5 * (t.goal_max_ned_m.z() - start_depth_m);
+  int dives = 0;
+  for (std::size_t i = 0; i < dived.size(); ++i) {
+    EXPECT_EQ(dived[i].start.thruster_efficiency, drawn[i].start.thruster_efficiency);
+    EXPECT_EQ(dived[i].start.position_ned_m, drawn[i].start.position_ned_m);
+    if (dived[i].goal_ned_m == drawn[i].goal_ned_m) continue;
+    ++dives;
+    EXPECT_TRUE(dived[i].start.thruster_efficiency.empty()) << "dives only among the plain ones";
+    const Eigen::Vector3d offset_m = dived[i].goal_ned_m - t.start_position_ned_m;
+    EXPECT_LE(offset_m.head<2>().norm(), 4.0 + 1e-12);
+    EXPECT_GE(dived[i].goal_ned_m.z(), from_m);
+    EXPECT_LE(dived[i].goal_ned_m.z(), t.goal_max_ned_m.z());
+  }
+  EXPECT_EQ(dives, 3) << "a quarter of the 12 plain way-points";
+  c.dive_fraction = 1.1;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+  c.dive_fraction = 0.25;
+  c.dive_across_m = 0.0;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
 TEST(ArrivalObjective, IsTheArrivalTimeBetweenStepsPlusTheWeightedHoldError) {
   const task::TaskConfig t = fast_task();
   FinetuneEpisode e;
