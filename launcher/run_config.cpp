@@ -95,8 +95,8 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
   t.field("noisy_fraction", &C::noisy_fraction, "0..1",
           "of the others, with sensor noise only (finetune.randomise's levels and scale)");
   t.field("dive_fraction", &C::dive_fraction, "0..1",
-          "of the others, a steep dive from their start (the lower half of the depth the region "
-          "allows below it)");
+          "of the others, a steep dive from the task's start (the lower half of the depth the "
+          "region allows below it)");
   t.field("dive_across_m", &C::dive_across_m, "m", "a dive's largest distance across");
   add_objective_fields(t);
   t.field("threads", &C::threads, "0: one per CPU", "policies evaluated at once");

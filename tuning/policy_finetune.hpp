@@ -67,7 +67,8 @@ struct FinetuneConfig {
   double noisy_fraction = 0.0;
   /// Of the way-points without randomised conditions, this share (spread through them) is a
   /// steep dive from the task's start instead, from a stream of its own: depth in the lower
-  /// half of what the region allows below the start, and at most dive_across_m across. Drawn
+  /// half of what the region allows below the start, and at most dive_across_m across (one of
+  /// them that any_start_fraction also picks starts elsewhere, as the others do). Drawn
   /// uniformly from the region, such a dive is one way-point in twenty or so, and a policy that
   /// pitches ever further nose-down there (the flip margin's price) is seldom priced for it.
   double dive_fraction = 0.0;
