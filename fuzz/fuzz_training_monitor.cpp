@@ -13,17 +13,11 @@
 #include "fuzz/fuzz_configs.hpp"
 #include "fuzz/fuzz_util.hpp"
 #include "launcher/training_monitor.hpp"
+#include "tests/launcher/manual_clock.hpp"
 
 using namespace auvrl;
 
 namespace {
-
-/// Time that moves only when the input says so.
-class InputClock : public launcher::Clock {
- public:
-  double now_s() const override { return t_s; }
-  double t_s = 0;
-};
 
 /// A control record: restart role bytes[0] as process bytes[1..2] (little-endian).
 void restart(const fuzz::Record& r, launcher::TrainingMonitor& monitor) {
@@ -35,8 +29,10 @@ void restart(const fuzz::Record& r, launcher::TrainingMonitor& monitor) {
 
 /// What the monitor keeps and says must stay within the run's size and be finite.
 void check(const launcher::TrainingMonitor& monitor) {
-  // Roles, former processes, simulators, discarding actors, the last 100 outcomes.
-  const std::size_t bound = std::size(fuzz::kMonitorRoles) + 1024 + fuzz::kMonitorActors * 2 + 100;
+  // Roles, former processes, simulators, discarding actors, the recent outcomes.
+  using Monitor = launcher::TrainingMonitor;
+  const std::size_t bound = std::size(fuzz::kMonitorRoles) + Monitor::kMaxFormerPids +
+                            fuzz::kMonitorActors * 2 + Monitor::kRecentEpisodes;
   const double rate = monitor.success_rate();
   if (monitor.entries() > bound || !std::isfinite(monitor.env_steps_per_s()) ||
       monitor.env_steps_per_s() < 0 || !(rate >= 0 && rate <= 1) ||
@@ -51,7 +47,7 @@ void check(const launcher::TrainingMonitor& monitor) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  InputClock clock;
+  launcher::ManualClock clock;  // moves only when the input says so
   launcher::TrainingMonitor monitor(fuzz::kMonitorActors, clock);
   int pid = fuzz::kMonitorFirstPid;
   for (const char* role : fuzz::kMonitorRoles) monitor.started(role, pid++);

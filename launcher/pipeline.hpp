@@ -21,7 +21,7 @@ namespace auvrl::launcher {
 struct SelectionDraw {
   const sim::VehicleModel& model;
   const task::TaskConfig& task;
-  std::uint64_t seed = 7890;
+  std::uint64_t seed;  ///< finetune.selection_seed
 };
 
 /// The trained policy to go on with: policy.nn, or policy_best.nn when the best seen ranks

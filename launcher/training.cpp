@@ -376,15 +376,13 @@ void TrainingSession::evaluate_newest_weights() {
 }
 
 std::string TrainingSession::status_line(double eta_s) const {
-  const auto& stats = monitor_.learner_stats();
-  const double updates_per_s = stats ? stats->updates_per_s : 0.0;
   const std::string best_text =
       best_->has_best() ? fmt::format("{}/{}", best_->best().reached, best_->best().episodes) : "-";
   return fmt::format(
       "episodes {}  success(100) {:.0f}%  beta {:.2f} m  env {:.0f} steps/s  updates {:.0f}/s  "
       "best {}  elapsed {}  left {}",
-      stats ? stats->episodes : 0, 100 * monitor_.success_rate(), monitor_.beta_m(),
-      monitor_.env_steps_per_s(), updates_per_s, best_text, format_duration(wall_s()),
+      monitor_.learner_episodes(), 100 * monitor_.success_rate(), monitor_.beta_m(),
+      monitor_.env_steps_per_s(), monitor_.updates_per_s(), best_text, format_duration(wall_s()),
       format_duration(eta_s));
 }
 
@@ -396,18 +394,17 @@ double TrainingSession::left_s() const {
   const RunConfig& rc = ctx_.rc;
   if (!rc.run.reproducible && rc.run.max_train_s > 0) return rc.run.max_train_s - wall_s();
   double left = -1;
-  const auto& stats = monitor_.learner_stats();
-  const std::int64_t learner_episodes = stats ? stats->episodes : 0;
+  const std::int64_t learner_episodes = monitor_.learner_episodes();
   if (rc.learner_max_episodes > 0 && learner_episodes > 0 && monitor_.episodes_seen() > 0) {
     left = static_cast<double>(rc.learner_max_episodes - learner_episodes) *
            ((clock_.now_s() - start_s_) / static_cast<double>(monitor_.episodes_seen()));
   }
   // Reproducible mode: the updates still to do at the learner's rate (the sooner end counts).
-  const double updates_per_s = stats ? stats->updates_per_s : 0.0;
+  const double updates_per_s = monitor_.updates_per_s();
   if (rc.run.reproducible && rc.learner_max_updates > 0 && updates_per_s > 0) {
+    const double updates_done = static_cast<double>(monitor_.learner_stats()->updates);
     const double by_updates =
-        std::max<double>(0.0, static_cast<double>(rc.learner_max_updates - stats->updates)) /
-        updates_per_s;
+        std::max(0.0, static_cast<double>(rc.learner_max_updates) - updates_done) / updates_per_s;
     left = left < 0 ? by_updates : std::min(left, by_updates);
   }
   return left;
@@ -417,13 +414,12 @@ std::optional<std::string> TrainingSession::show_progress() {
   if (clock_.now_s() < next_progress_s_) return std::nullopt;
   next_progress_s_ = clock_.now_s() + 1.0;
   const double eta_s = left_s();
-  const auto& stats = monitor_.learner_stats();
   ProgressRow row{wall_s(),
-                  stats ? stats->episodes : 0,
+                  monitor_.learner_episodes(),
                   monitor_.success_rate(),
                   monitor_.beta_m(),
                   monitor_.env_steps_per_s(),
-                  stats ? stats->updates_per_s : 0.0,
+                  monitor_.updates_per_s(),
                   0.0};
   if (best_->has_best()) {
     row.best_suite_success = static_cast<double>(best_->best().reached) / best_->best().episodes;

@@ -10,11 +10,6 @@ namespace auvrl::launcher {
 
 namespace {
 
-/// Episode outcomes the success rate is taken over.
-constexpr std::size_t kRecentEpisodes = 100;
-/// Former processes remembered (a long run's restarts); beyond it the lowest ids are forgotten
-/// (their late messages then count as foreign).
-constexpr std::size_t kMaxFormerPids = 1024;
 /// A simulator heard within this is answering, s.
 constexpr double kSimAnswersWithin_s = 3.0;
 

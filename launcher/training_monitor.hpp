@@ -42,6 +42,12 @@ struct DiscardingRun {
 /// The figures of a training run, from its participants' messages.
 class TrainingMonitor {
  public:
+  /// Episode outcomes the success rate is taken over.
+  static constexpr std::size_t kRecentEpisodes = 100;
+  /// Former processes remembered (a long run's restarts); beyond it the lowest ids are
+  /// forgotten (their late messages then count as foreign).
+  static constexpr std::size_t kMaxFormerPids = 1024;
+
   /// A run of `actors` actors (ids 0..actors-1, simulators "sim0".."sim<actors-1>"); times
   /// come from clock.
   TrainingMonitor(int actors, const Clock& clock);
@@ -66,6 +72,9 @@ class TrainingMonitor {
   std::int64_t episodes_seen() const { return episodes_seen_; }
   /// The learner's newest figures.
   const std::optional<auvrl_lcm::learner_stats_t>& learner_stats() const { return stats_; }
+  /// Of those: the episodes it has taken in and its updates per second (0 before any).
+  std::int64_t learner_episodes() const { return stats_ ? stats_->episodes : 0; }
+  double updates_per_s() const { return stats_ ? stats_->updates_per_s : 0.0; }
 
   /// The first actor whose episodes have all been discarded for at least discard_fault_s
   /// while its simulator was heard within the last 3 s (a hung simulator is the supervisor's).

@@ -1,11 +1,11 @@
-// A launcher Clock that moves only when the test says so.
+// A launcher Clock that moves only when the test (or a fuzz target's input) says so.
 #pragma once
 
 #include "launcher/supervisor.hpp"
 
 namespace auvrl::launcher {
 
-/// Time that moves only when the test sets t_s.
+/// Time that moves only when the test or the fuzz input sets t_s.
 class ManualClock : public Clock {
  public:
   double now_s() const override { return t_s; }

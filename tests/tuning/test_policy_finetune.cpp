@@ -191,15 +191,22 @@ TEST(FinetuneEpisodes, TheRandomisedOnesRunTheirOwnLength) {
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
 
-// noisy_fraction: that share of the way-points without randomised conditions gets sensor noise
-// at finetune.randomise's levels (scaled by a drawn factor) and nothing else; the way-points,
-// headings and faults stay as they were.
-TEST(FinetuneEpisodes, NoiseTheShareAskedOfThePlainOnes) {
+// Twenty way-points, half of them turned and eight faulted: the twelve plain ones are those that
+// noisy_fraction and dive_fraction take their shares of.
+FinetuneConfig twelve_plain_of_twenty() {
   FinetuneConfig c;
   c.episodes = 20;
   c.random_heading_fraction = 0.5;
   c.randomised_fraction = 0.4;
   c.randomise.fault_probability = 1.0;
+  return c;
+}
+
+// noisy_fraction: that share of the way-points without randomised conditions gets sensor noise
+// at finetune.randomise's levels (scaled by a drawn factor) and nothing else; the way-points,
+// headings and faults stay as they were.
+TEST(FinetuneEpisodes, NoiseTheShareAskedOfThePlainOnes) {
+  FinetuneConfig c = twelve_plain_of_twenty();
   c.randomise.sensor_noise_scale = {0.5, 1.5};
   const auto quiet = finetune_episodes(fast_task(), c, 9);
   c.noisy_fraction = 0.25;
@@ -233,11 +240,7 @@ TEST(FinetuneEpisodes, NoiseTheShareAskedOfThePlainOnes) {
 // (the lower half of the depth below it, at most dive_across_m across); the others, the
 // headings and the randomised ones do not move.
 TEST(FinetuneEpisodes, DiveTheShareAskedOfThePlainOnes) {
-  FinetuneConfig c;
-  c.episodes = 20;
-  c.random_heading_fraction = 0.5;
-  c.randomised_fraction = 0.4;
-  c.randomise.fault_probability = 1.0;
+  FinetuneConfig c = twelve_plain_of_twenty();
   const task::TaskConfig t = fast_task();
   const auto drawn = finetune_episodes(t, c, 9);
   c.dive_fraction = 0.25;
