@@ -47,20 +47,21 @@ ThrusterFaultAccommodation::ThrusterFaultAccommodation(const TaskConfig& task) :
 
 void ThrusterFaultAccommodation::reset() {
   const int n = task_.num_thrusters;
-  previous_command_ = realised_n_ = command_ = rhs_ = spread_ = Eigen::VectorXd::Zero(n);
+  previous_command_ = realised_n_ = command_ = shortfall_ = rhs_ = makeup_ =
+      Eigen::VectorXd::Zero(n);
   system_ = Eigen::MatrixXd::Zero(n, n);
   solver_ = Eigen::LDLT<Eigen::MatrixXd>(n);
   replica_delayed_n_ = replica_n_ = Eigen::VectorXd::Zero(n);
   moment_realised_replica_ = moment_replica_squared_ = Eigen::VectorXd::Zero(n);
-  efficiency_ = Eigen::VectorXd::Ones(n);
-  keep_ = Eigen::VectorXd::Ones(n);
-  any_dead_ = false;
+  efficiency_ = share_ = healthy_ = Eigen::VectorXd::Ones(n);
+  condition_.assign(static_cast<std::size_t>(n), Condition::kHealthy);
+  any_faulty_ = false;
 }
 
 void ThrusterFaultAccommodation::apply(const Eigen::Ref<const StateVector>& state,
                                        ActionVector& action) {
   if (estimate(state)) factorise();
-  if (any_dead_) redistribute(action);
+  if (any_faulty_) redistribute(action);
 }
 
 // The replica steps as sim::step treats a command: the one-step delay, the lag toward the
@@ -68,7 +69,7 @@ void ThrusterFaultAccommodation::apply(const Eigen::Ref<const StateVector>& stat
 // vehicle took one step ago, its realised thrust the replica's thrust after this update.
 bool ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& state) {
   const ThrusterDynamics& td = task_.thruster_dynamics;
-  bool newly_dead = false;
+  bool changed = false;
   previous_action_from_state(task_, state, previous_command_);
   realised_thrust_from_state(task_, state, realised_n_);
   const double min_squared = kMinReplicaThrustN * kMinReplicaThrustN;
@@ -87,29 +88,48 @@ bool ThrusterFaultAccommodation::estimate(const Eigen::Ref<const StateVector>& s
     if (moment_replica_squared_[i] >= min_squared) {
       efficiency_[i] =
           std::clamp(moment_realised_replica_[i] / moment_replica_squared_[i], 0.0, 1.0);
-      if (keep_[i] != 0.0 && efficiency_[i] < task_.fault_accommodation.dead_below) {
-        keep_[i] = 0.0;
-        newly_dead = true;
-      }
+      changed = classify(i) || changed;
     }
   }
-  return newly_dead;
+  return changed;
+}
+
+bool ThrusterFaultAccommodation::classify(int i) {
+  const FaultAccommodationSettings& s = task_.fault_accommodation;
+  const auto k = static_cast<std::size_t>(i);
+  const Condition before = condition_[k];
+  if (efficiency_[i] < s.dead_below) {
+    condition_[k] = Condition::kDead;
+  } else if (before == Condition::kHealthy && efficiency_[i] < s.weak_below) {
+    condition_[k] = Condition::kWeak;
+  }
+  if (condition_[k] == Condition::kWeak) share_[i] = efficiency_[i];
+  if (condition_[k] == Condition::kDead) share_[i] = 0.0;
+  return condition_[k] != before;
 }
 
 void ThrusterFaultAccommodation::factorise() {
-  any_dead_ = true;
-  system_.noalias() = keep_.asDiagonal() * wrench_gram_ * keep_.asDiagonal();
+  any_faulty_ = true;
+  for (int i = 0; i < task_.num_thrusters; ++i) {
+    healthy_[i] = condition_[static_cast<std::size_t>(i)] == Condition::kHealthy ? 1.0 : 0.0;
+  }
+  system_.noalias() = healthy_.asDiagonal() * wrench_gram_ * healthy_.asDiagonal();
   system_.diagonal().array() += damping_;
   solver_.compute(system_);
 }
 
 void ThrusterFaultAccommodation::redistribute(ActionVector& action) {
   command_ = action.cast<double>();  // normalised: the scale cancels
-  rhs_.noalias() = wrench_gram_ * command_;
-  rhs_ = keep_.cwiseProduct(rhs_) + damping_ * keep_.cwiseProduct(command_);
-  spread_ = solver_.solve(rhs_);
+  shortfall_ = (1.0 - share_.array()) * command_.array();
+  rhs_.noalias() = wrench_gram_ * shortfall_;
+  rhs_ = healthy_.cwiseProduct(rhs_);
+  makeup_ = solver_.solve(rhs_);
   for (int i = 0; i < task_.num_thrusters; ++i) {
-    action[i] = static_cast<float>(std::clamp(spread_[i], -1.0, 1.0));
+    const Condition c = condition_[static_cast<std::size_t>(i)];
+    const double command = c == Condition::kDead      ? 0.0
+                           : c == Condition::kHealthy ? command_[i] + makeup_[i]
+                                                      : command_[i];
+    action[i] = static_cast<float>(std::clamp(command, -1.0, 1.0));
   }
 }
 

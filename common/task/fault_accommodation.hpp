@@ -1,9 +1,10 @@
-// Thruster fault accommodation for a policy that drives: find a dead thruster from what it
-// delivers, stop commanding it and give its share of the body wrench to the others.
+// Thruster fault accommodation for a policy that drives: find a weak or dead thruster from what
+// it delivers and have the healthy ones make up the body wrench it fails to deliver.
 #pragma once
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <vector>
 
 #include "common/task/task.hpp"
 
@@ -18,12 +19,16 @@ bool has_fault_accommodation(const TaskConfig& task);
 /// the thrust each thruster realised; a replica of a healthy thruster (the vehicle's delay, lag
 /// and slew, ThrusterDynamics) says what each should have realised, and an exponentially
 /// weighted least-squares ratio of the two estimates its efficiency. A thruster whose estimate
-/// falls below dead_below is dead until reset(): the policy's commands u (N) become u' solving
-///   (E B'B E + lambda I) u' = E B'B u + lambda E u,
-/// with B the thrusters' wrench matrix, E = diag(0 for a dead thruster, 1 otherwise) and
-/// lambda = damping * trace(B'B) / n. With every thruster healthy u' = u exactly; a dead one
-/// gets 0; the others take up its wrench as far as the damping lets them. Commands are clamped
-/// to [-1, 1] again. A step allocates nothing (a vehicle's control loop).
+/// falls below weak_below is weak until reset(), its share s_i of a command the estimate (kept
+/// up to date); below dead_below it is dead, s_i = 0. The policy's commands u (N) become
+///   u'_i = u_i + d_i (healthy),  u_i (weak),  0 (dead),  where
+///   (H B'B H + lambda I) d = H B'B ((1 - s) o u),
+/// with B the thrusters' wrench matrix, H = diag(1 for a healthy thruster, 0 otherwise), o the
+/// element-wise product and lambda = damping * trace(B'B) / n: the healthy thrusters make up
+/// the wrench that the weak and dead ones fail to deliver, as far as the damping lets them (the
+/// least-squares solution of B_h d_h = B (1 - s) o u, damped). With every thruster healthy
+/// u' = u exactly. Commands are clamped to [-1, 1] again. A step allocates nothing (a vehicle's
+/// control loop).
 class ThrusterFaultAccommodation {
  public:
   /// The estimate moves only while a healthy thruster would deliver at least this much (RMS
@@ -41,7 +46,9 @@ class ThrusterFaultAccommodation {
   /// Each thruster's estimated efficiency (1 until enough thrust was asked of it).
   const Eigen::VectorXd& efficiency_estimate() const { return efficiency_; }
   /// Whether thruster i (0-based) counts as dead.
-  bool dead(int i) const { return keep_[i] == 0.0; }
+  bool dead(int i) const { return condition_[i] == Condition::kDead; }
+  /// Whether thruster i (0-based) counts as weak (not dead).
+  bool weak(int i) const { return condition_[i] == Condition::kWeak; }
   // The constants it runs with (the C export writes them out).
   const Eigen::MatrixXd& wrench_gram() const { return wrench_gram_; }  ///< B'B, n x n
   double damping() const { return damping_; }                          ///< lambda
@@ -50,10 +57,14 @@ class ThrusterFaultAccommodation {
   double slew_step_n() const { return slew_step_n_; }      ///< the replica's largest step, N
 
  private:
-  /// Updates the efficiency estimates; true if a thruster was found dead this step.
+  enum class Condition { kHealthy, kWeak, kDead };
+  /// Updates the efficiency estimates and the weak thrusters' shares; true if a thruster was
+  /// found weak or dead this step.
   bool estimate(const Eigen::Ref<const StateVector>& state);
-  /// The damped least-squares system for the thrusters now dead, factorised (it changes only
-  /// when one more dies).
+  /// Marks thruster i weak or dead as its estimate says; true if its condition changed.
+  bool classify(int i);
+  /// The damped least-squares system for the thrusters now healthy, factorised (it changes
+  /// only when one more is found weak or dead).
   void factorise();
   void redistribute(ActionVector& action);
 
@@ -66,12 +77,14 @@ class ThrusterFaultAccommodation {
   Eigen::VectorXd replica_delayed_n_, replica_n_;  ///< a healthy thruster's command and thrust
   Eigen::VectorXd moment_realised_replica_, moment_replica_squared_;
   Eigen::VectorXd efficiency_;
-  Eigen::VectorXd keep_;                 ///< E: 0 for a thruster found dead, 1 otherwise
-  bool any_dead_ = false;                ///< some entry of keep_ is 0
-  Eigen::MatrixXd system_;               ///< E B'B E + lambda I
+  std::vector<Condition> condition_;
+  Eigen::VectorXd share_;                ///< s: 1 healthy, the estimate when weak, 0 dead
+  Eigen::VectorXd healthy_;              ///< H's diagonal
+  bool any_faulty_ = false;              ///< some thruster is weak or dead
+  Eigen::MatrixXd system_;               ///< H B'B H + lambda I
   Eigen::LDLT<Eigen::MatrixXd> solver_;  ///< its factorisation
   // Scratch, sized once: a step allocates nothing.
-  Eigen::VectorXd previous_command_, realised_n_, command_, rhs_, spread_;
+  Eigen::VectorXd previous_command_, realised_n_, command_, shortfall_, rhs_, makeup_;
 };
 
 }  // namespace auvrl::task

@@ -225,6 +225,12 @@ void FaultAccommodationSettings::validate() const {
         fmt::format("task.fault_accommodation.dead_below must be in [0, 1) (an efficiency), got {}",
                     dead_below));
   }
+  if (!(weak_below >= dead_below && weak_below < 1)) {
+    throw std::invalid_argument(
+        fmt::format("task.fault_accommodation.weak_below must be in [dead_below = {}, 1) (an "
+                    "efficiency), got {}",
+                    dead_below, weak_below));
+  }
   for (const auto& [value, name] : {std::pair{estimate_time_constant_s, "estimate_time_constant_s"},
                                     std::pair{damping, "damping"}}) {
     if (!std::isfinite(value) || value <= 0) {

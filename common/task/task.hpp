@@ -100,15 +100,19 @@ struct PositionFilterSettings {
 /// Thruster fault accommodation for a driving policy (evaluation, missions, deployment; not
 /// the fine-tuning's own episodes nor the actors'; task::ThrusterFaultAccommodation): each
 /// thruster's efficiency is estimated from its realised thrust against a healthy thruster's
-/// response to the same commands; once it falls below dead_below the thruster is dead until
-/// the next reset: it is no longer commanded, and its share of the policy's body wrench goes
-/// to the others in damped least squares. Needs the extended_thrust layout (the realised
-/// thrust); the other layouts drive without it.
+/// response to the same commands. Once it falls below weak_below the thruster is weak until the
+/// next reset: it keeps the policy's commands and the healthy thrusters make up the wrench it
+/// fails to deliver; below dead_below it is dead: it is no longer commanded and its whole share
+/// of the policy's body wrench goes to the healthy ones, in damped least squares either way.
+/// Needs the extended_thrust layout (the realised thrust); the other layouts drive without it.
 struct FaultAccommodationSettings {
   bool enabled = true;
   /// Estimated efficiency (realised over a healthy thruster's thrust) below which a thruster
-  /// counts as dead. Weak thrusters above it keep the policy's commands.
+  /// counts as dead.
   double dead_below = 0.05;
+  /// Estimated efficiency below which a thruster counts as weak (at least dead_below; equal to
+  /// it: dead thrusters only).
+  double weak_below = 0.3;
   /// Time constant of the efficiency estimate, s.
   double estimate_time_constant_s = 2.0;
   /// Damping of the redistribution, relative to the mean squared column of the thrusters'

@@ -112,13 +112,18 @@ config::Table<PositionFilterSettings> make_position_filter_table() {
 config::Table<FaultAccommodationSettings> make_fault_accommodation_table() {
   using F = FaultAccommodationSettings;
   config::Table<F> t("fault_accommodation",
-                     "a driving policy's answer to a dead thruster (evaluation, missions, "
+                     "a driving policy's answer to a weak or dead thruster (evaluation, missions, "
                      "deployment; not the fine-tuning's episodes nor the actors'; extended_thrust "
-                     "layout): detected from its realised thrust, no longer commanded, its share "
-                     "of the wrench given to the others");
-  t.field("enabled", &F::enabled, "", "accommodate dead thrusters when a policy drives");
+                     "layout): detected from its realised thrust; the healthy thrusters make up "
+                     "the wrench it fails to deliver, and a dead one is no longer commanded");
+  t.field("enabled", &F::enabled, "", "accommodate weak and dead thrusters when a policy drives");
   t.field("dead_below", &F::dead_below, "efficiency",
           "a thruster whose estimated efficiency falls below this counts as dead")
+      .range(0.0, 1.0);
+  t.field("weak_below", &F::weak_below, "efficiency",
+          "a thruster whose estimated efficiency falls below this counts as weak: it keeps the "
+          "policy's commands and the healthy ones make up its shortfall (dead_below: dead "
+          "thrusters only)")
       .range(0.0, 1.0);
   t.field("estimate_time_constant_s", &F::estimate_time_constant_s, "s",
           "time constant of the efficiency estimate")

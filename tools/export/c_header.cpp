@@ -372,6 +372,7 @@ std::string fault_constants(const task::ThrusterFaultAccommodation& fa,
   const ThrusterDynamics& td = task.thruster_dynamics;
   std::string out = fmt::format(
       "#define AUVRL_POLICY_FAULT_DEAD_BELOW_ {}\n"
+      "#define AUVRL_POLICY_FAULT_WEAK_BELOW_ {}\n"
       "#define AUVRL_POLICY_FAULT_ESTIMATE_GAIN_ {}\n"
       "#define AUVRL_POLICY_FAULT_MIN_SQUARED_N2_ {}\n"
       "#define AUVRL_POLICY_FAULT_DAMPING_ {}\n"
@@ -381,7 +382,8 @@ std::string fault_constants(const task::ThrusterFaultAccommodation& fa,
       "#define AUVRL_POLICY_THRUST_SLEW_STEP_N_ {}\n"
       "static const double auvrl_policy_wrench_gram_[AUVRL_POLICY_NUM_THRUSTERS]"
       "[AUVRL_POLICY_NUM_THRUSTERS] = {{\n",
-      c_double_literal(task.fault_accommodation.dead_below), c_double_literal(fa.estimate_gain()),
+      c_double_literal(task.fault_accommodation.dead_below),
+      c_double_literal(task.fault_accommodation.weak_below), c_double_literal(fa.estimate_gain()),
       c_double_literal(task::ThrusterFaultAccommodation::kMinReplicaThrustN *
                        task::ThrusterFaultAccommodation::kMinReplicaThrustN),
       c_double_literal(fa.damping()), td.delay_enabled ? 1 : 0, c_double_literal(fa.lag_blend()),
@@ -421,9 +423,14 @@ std::string fault_estimate_lines() {
          "    if (fa->moment_replica_squared[i] >= AUVRL_POLICY_FAULT_MIN_SQUARED_N2_) {\n"
          "      double e = fa->moment_realised_replica[i] / fa->moment_replica_squared[i];\n"
          "      e = e < 0.0 ? 0.0 : e > 1.0 ? 1.0 : e;\n"
-         "      if (e < AUVRL_POLICY_FAULT_DEAD_BELOW_) fa->dead[i] = 1;\n"
+         "      if (e < AUVRL_POLICY_FAULT_DEAD_BELOW_) {\n"
+         "        fa->condition[i] = 2;\n"
+         "      } else if (fa->condition[i] == 0 && e < AUVRL_POLICY_FAULT_WEAK_BELOW_) {\n"
+         "        fa->condition[i] = 1;\n"
+         "      }\n"
+         "      if (fa->condition[i] == 1) fa->share[i] = e;\n"
          "    }\n"
-         "    if (fa->dead[i]) any = 1;\n"
+         "    if (fa->condition[i]) any = 1;\n"
          "  }\n";
 }
 
@@ -431,15 +438,20 @@ std::string fault_estimate_lines() {
 std::string fault_redistribution_lines() {
   return "  if (!any) return;\n"
          "  for (i = 0; i < n; ++i) {\n"
-         "    const double keep_i = fa->dead[i] ? 0.0 : 1.0;\n"
+         "    const double share = fa->condition[i] == 0 ? 1.0 : fa->condition[i] == 1 ? "
+         "fa->share[i] : 0.0;\n"
+         "    shortfall[i] = (1.0 - share) * (double)action[i];\n"
+         "  }\n"
+         "  for (i = 0; i < n; ++i) {\n"
+         "    const double healthy_i = fa->condition[i] == 0 ? 1.0 : 0.0;\n"
          "    double wrench = 0.0;\n"
          "    for (j = 0; j < n; ++j) {\n"
-         "      const double keep_j = fa->dead[j] ? 0.0 : 1.0;\n"
-         "      a[i][j] = keep_i * auvrl_policy_wrench_gram_[i][j] * keep_j;\n"
-         "      wrench += auvrl_policy_wrench_gram_[i][j] * (double)action[j];\n"
+         "      const double healthy_j = fa->condition[j] == 0 ? 1.0 : 0.0;\n"
+         "      a[i][j] = healthy_i * auvrl_policy_wrench_gram_[i][j] * healthy_j;\n"
+         "      wrench += auvrl_policy_wrench_gram_[i][j] * shortfall[j];\n"
          "    }\n"
          "    a[i][i] += AUVRL_POLICY_FAULT_DAMPING_;\n"
-         "    x[i] = keep_i * wrench + AUVRL_POLICY_FAULT_DAMPING_ * keep_i * (double)action[i];\n"
+         "    x[i] = healthy_i * wrench;\n"
          "  }\n"
          "  /* a = L L^T in place (lower triangle), then L y = x, L^T u = y. */\n"
          "  for (j = 0; j < n; ++j) {\n"
@@ -458,8 +470,11 @@ std::string fault_redistribution_lines() {
          "    for (k = i + 1; k < n; ++k) x[i] -= a[k][i] * x[k];\n"
          "    x[i] /= a[i][i];\n"
          "  }\n"
-         "  for (i = 0; i < n; ++i) action[i] = (float)(x[i] < -1.0 ? -1.0 : x[i] > 1.0 ? 1.0 : "
-         "x[i]);\n";
+         "  for (i = 0; i < n; ++i) {\n"
+         "    double u = fa->condition[i] == 0 ? (double)action[i] + x[i]\n"
+         "             : fa->condition[i] == 1 ? (double)action[i] : 0.0;\n"
+         "    action[i] = (float)(u < -1.0 ? -1.0 : u > 1.0 ? 1.0 : u);\n"
+         "  }\n";
 }
 
 /// auvrl_fault_accommodation and auvrl_policy_accommodate_faults:
@@ -471,16 +486,18 @@ std::string accommodate_faults_function(const ExportedPolicy& policy) {
       " * (task::ThrusterFaultAccommodation, docs/usage.md \"Fault accommodation\"): once per\n"
       " * control step, after auvrl_policy_act, on the state the policy was given and its\n"
       " * action, rewritten in place. A replica of a healthy thruster estimates each thruster's\n"
-      " * efficiency from the state's realised thrust; one below the dead threshold is dead until\n"
-      " * the struct is zeroed again: it gets 0 and the others take up its share of the body\n"
-      " * wrench in damped least squares. With every thruster healthy the action is untouched.\n"
-      " * Zero the struct at the start of a mission. */\n"
+      " * efficiency from the state's realised thrust; one below the weak threshold is weak until\n"
+      " * the struct is zeroed again (it keeps its command and the healthy thrusters make up the\n"
+      " * wrench it fails to deliver), one below the dead threshold is dead (it gets 0 and the\n"
+      " * healthy ones take up its whole share), in damped least squares. With every thruster\n"
+      " * healthy the action is untouched. Zero the struct at the start of a mission. */\n"
       "typedef struct auvrl_fault_accommodation {\n"
       "  double replica_delayed_n[AUVRL_POLICY_NUM_THRUSTERS]; /* a healthy thruster's command */\n"
       "  double replica_n[AUVRL_POLICY_NUM_THRUSTERS];         /* and its thrust, N */\n"
       "  double moment_realised_replica[AUVRL_POLICY_NUM_THRUSTERS];\n"
       "  double moment_replica_squared[AUVRL_POLICY_NUM_THRUSTERS];\n"
-      "  int dead[AUVRL_POLICY_NUM_THRUSTERS]; /* 1: found dead */\n"
+      "  int condition[AUVRL_POLICY_NUM_THRUSTERS]; /* 0 healthy, 1 found weak, 2 found dead */\n"
+      "  double share[AUVRL_POLICY_NUM_THRUSTERS];  /* a weak one's estimated efficiency */\n"
       "} auvrl_fault_accommodation;\n\n";
   if (!fa) {
     return out +
@@ -495,7 +512,7 @@ std::string accommodate_faults_function(const ExportedPolicy& policy) {
          "{\n"
          "  const int n = AUVRL_POLICY_NUM_THRUSTERS;\n"
          "  double a[AUVRL_POLICY_NUM_THRUSTERS][AUVRL_POLICY_NUM_THRUSTERS];\n"
-         "  double x[AUVRL_POLICY_NUM_THRUSTERS];\n"
+         "  double x[AUVRL_POLICY_NUM_THRUSTERS], shortfall[AUVRL_POLICY_NUM_THRUSTERS];\n"
          "  int i, j, k, any = 0;\n" +
          fault_estimate_lines() + fault_redistribution_lines() + "}\n";
 }
