@@ -573,6 +573,31 @@ TEST(RobustnessRun, FaultAccommodationHoldsCloserWithADeadThruster) {
   }
 }
 
+// A weak thruster keeps the policy's command while the healthy ones make up what it fails to
+// deliver (task.fault_accommodation.weak_below): the committed policy reaches the paper's fault
+// (T1 at 10 %) sooner, and holds closer with its front vertical thruster at 10 %, than with
+// dead thrusters only accommodated (weak_below at dead_below).
+TEST(RobustnessRun, FaultAccommodationMakesUpAWeakThrustersShortfall) {
+  EvaluationConfig c = config();
+  task::apply_vehicle(nessie().facts(), c.task);
+  ASSERT_GT(c.task.fault_accommodation.weak_below, c.task.fault_accommodation.dead_below);
+  EvaluationConfig dead_only = c;
+  dead_only.task.fault_accommodation.weak_below = dead_only.task.fault_accommodation.dead_below;
+  const std::vector<EvaluationEpisode> fault = {scenario_episodes(c, Scenario::kFault).at(0)};
+  const double weak_s = committed_policy_rows(c, fault).at(0).time_to_reach_s;
+  const double dead_only_s = committed_policy_rows(dead_only, fault).at(0).time_to_reach_s;
+  const std::vector<EvaluationEpisode> t6 = of_group(robustness_episodes(c, 6, 6, 1), "t6_10pct");
+  ASSERT_EQ(t6.size(), 6u);
+  const auto hold = [](const SummaryRow& r) { return r.mean_error_after_reach_m; };
+  const double weak_m = mean_of(committed_policy_rows(c, t6), hold);
+  const double dead_only_m = mean_of(committed_policy_rows(dead_only, t6), hold);
+  std::cout << "the fault: " << weak_s << " s with weak thrusters accommodated, " << dead_only_s
+            << " s with dead ones only; T6 at 10 %: hold error " << weak_m << " m, " << dead_only_m
+            << " m\n";
+  EXPECT_LT(weak_s, dead_only_s);
+  EXPECT_LT(weak_m, dead_only_m);
+}
+
 TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {
   TempDir dir;
   agent::PidController pid(nessie());
