@@ -41,8 +41,8 @@ class PolicyController final : public Controller {
   /// task.fault_accommodation says (extended_thrust layout only). The actors' exploring policy
   /// never uses them; a policy that drives does.
   void use_driving_aids(const task::TaskConfig& task);
-  /// Clears the integrator, the position filter and the thrusters found dead (the start of an
-  /// episode or mission).
+  /// Clears the integrator, the position filter and the thrusters found weak or dead (the start of
+  /// an episode or mission).
   void reset() override {
     goal_offset_ned_m_.setZero();
     if (position_filter_) position_filter_->reset();

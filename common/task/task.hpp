@@ -116,8 +116,8 @@ struct FaultAccommodationSettings {
   /// Time constant of the efficiency estimate, s.
   double estimate_time_constant_s = 2.0;
   /// Damping of the redistribution, relative to the mean squared column of the thrusters'
-  /// wrench matrix: small values rebuild the whole wrench with the remaining thrusters, large
-  /// ones only stop commanding the dead thruster.
+  /// wrench matrix: small values rebuild the whole wrench with the healthy thrusters, large
+  /// ones leave their commands alone (a dead thruster still gets none).
   double damping = 1.0;
   /// Throws std::invalid_argument naming the first unusable value (task.fault_accommodation.*).
   void validate() const;
@@ -191,7 +191,8 @@ struct TaskConfig {
   GoalIntegralSettings integral;
   /// The driving policy's position estimate (not the paper's: its preset turns it off).
   PositionFilterSettings position_filter;
-  /// The driving policy's answer to a dead thruster (not the paper's: its preset turns it off).
+  /// The driving policy's answer to a weak or dead thruster (not the paper's: its preset turns it
+  /// off).
   FaultAccommodationSettings fault_accommodation;
 
   /// Size of the observation vector.

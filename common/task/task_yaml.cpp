@@ -129,8 +129,8 @@ config::Table<FaultAccommodationSettings> make_fault_accommodation_table() {
           "time constant of the efficiency estimate")
       .positive();
   t.field("damping", &F::damping, "",
-          "damping of the redistribution (small: rebuild the whole wrench; large: only stop "
-          "commanding the dead thruster)")
+          "damping of the redistribution (small: rebuild the whole wrench; large: leave the "
+          "healthy thrusters' commands alone, a dead one still gets none)")
       .positive();
   return t;
 }
