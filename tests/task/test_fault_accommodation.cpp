@@ -32,6 +32,22 @@ TaskConfig fast_layout() {
   return task;
 }
 
+/// The thrusters' wrench matrix B (6 x n, one column per thruster) of the task.
+Eigen::MatrixXd wrench_matrix(const TaskConfig& task) {
+  Eigen::MatrixXd wrench(6, task.num_thrusters);
+  for (int i = 0; i < task.num_thrusters; ++i) {
+    for (int k = 0; k < 6; ++k) wrench(k, i) = task.thruster_wrench[i][k];
+  }
+  return wrench;
+}
+
+/// Six thruster efficiencies, all 1 but thruster `faulty` (0-based).
+std::vector<double> all_healthy_but(int faulty, double efficiency) {
+  std::vector<double> out(6, 1.0);
+  out[static_cast<std::size_t>(faulty)] = efficiency;
+  return out;
+}
+
 /// A vehicle (the simulator in this process) driven by smoothly wandering commands (a random
 /// walk in [-1, 1]), each step's commands passed through the accommodation as a driving
 /// policy's would be.
@@ -104,14 +120,9 @@ TEST(FaultAccommodation, TakesNoSlowThrusterForAWeakOrDeadOne) {
 // pitch to one, which cannot give both).
 TEST(FaultAccommodation, FindsADeadThrusterAndGivesItsWrenchToTheOthers) {
   const TaskConfig task = fast_layout();
-  Eigen::MatrixXd wrench(6, 6);
-  for (int i = 0; i < 6; ++i) {
-    for (int k = 0; k < 6; ++k) wrench(k, i) = task.thruster_wrench[i][k];
-  }
+  const Eigen::MatrixXd wrench = wrench_matrix(task);
   for (int dead = 0; dead < 6; ++dead) {
-    std::vector<double> efficiency(6, 1.0);
-    efficiency[static_cast<std::size_t>(dead)] = 0.0;
-    Drive drive(nessie(), task, efficiency);
+    Drive drive(nessie(), task, all_healthy_but(dead, 0.0));
     int found = -1;
     for (int t = 0; t < 100 && found < 0; ++t) {
       drive.step();
@@ -141,14 +152,9 @@ TEST(FaultAccommodation, FindsADeadThrusterAndGivesItsWrenchToTheOthers) {
 // commands asked of it while the others move to deliver part of the wrench it fails to.
 TEST(FaultAccommodation, MeasuresAWeakThrusterAndMakesUpItsShortfall) {
   const TaskConfig task = fast_layout();
-  Eigen::MatrixXd wrench(6, 6);
-  for (int i = 0; i < 6; ++i) {
-    for (int k = 0; k < 6; ++k) wrench(k, i) = task.thruster_wrench[i][k];
-  }
+  const Eigen::MatrixXd wrench = wrench_matrix(task);
   for (int weak = 0; weak < 6; ++weak) {
-    std::vector<double> efficiency(6, 1.0);
-    efficiency[static_cast<std::size_t>(weak)] = 0.1;
-    Drive drive(nessie(), task, efficiency);
+    Drive drive(nessie(), task, all_healthy_but(weak, 0.1));
     int found = -1;
     for (int t = 0; t < 100 && found < 0; ++t) {
       const ActionVector sent = drive.step();

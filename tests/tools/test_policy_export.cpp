@@ -381,15 +381,14 @@ TEST(PolicyExportC, FiltersThePositionAsAuvrlDoes) {
 // Runs the header's fault accommodation and auvrl's (task::ThrusterFaultAccommodation) on the
 // same 300 steps of the simulator with these thruster efficiencies, the states the
 // simulator's and the actions a random walk; returns the faults auvrl found. The actions must
-// agree step by step.
-task::ThrusterFaultAccommodation accommodate_like_auvrl(const std::vector<double>& efficiency,
+// agree step by step. cc: the C compiler that builds the driver.
+task::ThrusterFaultAccommodation accommodate_like_auvrl(const std::string& cc,
+                                                        const std::vector<double>& efficiency,
                                                         std::vector<float>& actions) {
   task::TaskConfig c;
   c.layout = task::StateLayout::kExtendedThrust;
   task::apply_vehicle(nessie().facts(), c);
   task::ThrusterFaultAccommodation faults(c);
-  const std::string cc = find_program("cc");
-  if (cc.empty()) return faults;
   TempDir dir;
   const std::string exe = build_driver(dir, kPolicy, cc);
   EXPECT_FALSE(exe.empty());
@@ -433,12 +432,11 @@ task::ThrusterFaultAccommodation accommodate_like_auvrl(const std::vector<double
 // The header finds the front vertical thruster dead when auvrl does and rewrites the actions
 // as auvrl does.
 TEST(PolicyExportC, AccommodatesADeadThrusterAsAuvrlDoes) {
-  if (find_program("cc").empty()) {
-    GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
-  }
+  const std::string cc = find_program("cc");
+  if (cc.empty()) GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
   std::vector<float> actions;
   const task::ThrusterFaultAccommodation faults =
-      accommodate_like_auvrl({1, 1, 1, 1, 1, 0}, actions);
+      accommodate_like_auvrl(cc, {1, 1, 1, 1, 1, 0}, actions);
   ASSERT_TRUE(faults.dead(5));
   ASSERT_FALSE(actions.empty());
   EXPECT_EQ(actions[actions.size() - 1], 0.0f);  // T6, dead, gets nothing
@@ -447,12 +445,11 @@ TEST(PolicyExportC, AccommodatesADeadThrusterAsAuvrlDoes) {
 // The same with T1 at 10 % as well: weak, it keeps the walk's commands while the healthy
 // thrusters make up its shortfall, as auvrl's do.
 TEST(PolicyExportC, AccommodatesAWeakAndADeadThrusterAsAuvrlDoes) {
-  if (find_program("cc").empty()) {
-    GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
-  }
+  const std::string cc = find_program("cc");
+  if (cc.empty()) GTEST_SKIP() << "no C compiler `cc` on PATH (apt-get install build-essential)";
   std::vector<float> actions;
   const task::ThrusterFaultAccommodation faults =
-      accommodate_like_auvrl({0.1, 1, 1, 1, 1, 0}, actions);
+      accommodate_like_auvrl(cc, {0.1, 1, 1, 1, 1, 0}, actions);
   ASSERT_TRUE(faults.weak(0));
   ASSERT_TRUE(faults.dead(5));
   for (int i = 1; i < 5; ++i) EXPECT_FALSE(faults.weak(i) || faults.dead(i)) << "T" << i + 1;
