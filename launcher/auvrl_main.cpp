@@ -323,7 +323,8 @@ int run_finetune_command(int argc, const char* const* argv) {
   cli.require("out");
   cli.option("config", &options.config_path, "take the finetune: section from this file");
   cli.option("policy", &options.policy_path,
-             "the policy to fine-tune (default: the one the run's evaluation used)");
+             "the policy to fine-tune (default: the one the run's fine-tuning started from, "
+             "else the one its evaluation used)");
   cli.option("iterations", &options.iterations, "fine-tuning iterations (default: the config's)");
   cli.option("seed", &options.seed, "seed of the fine-tuning's way-points (default: the run's)");
   cli.option("candidates", &options.candidates,

@@ -287,9 +287,36 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   return tuned_path;
 }
 
+namespace {
+
+/// Writes RUN/finetune_start.txt naming start_path (relative when inside the run directory).
+void record_finetune_start(const std::string& run_dir, const std::string& start_path,
+                           std::ostream& out) {
+  const fs::path path = fs::path(run_dir) / kFinetuneStartFile;
+  const fs::path start = fs::absolute(start_path).lexically_normal();
+  const fs::path relative = start.lexically_relative(fs::absolute(run_dir).lexically_normal());
+  const bool inside = !relative.empty() && *relative.begin() != "..";
+  std::ofstream file(path);
+  file << (inside ? relative : start).string() << "\n";
+  file.flush();
+  if (!file) out << "auvrl train: could not write " << path.string() << "\n";
+}
+
+}  // namespace
+
+std::optional<std::string> finetune_start(const std::string& run_dir) {
+  std::ifstream file(fs::path(run_dir) / kFinetuneStartFile);
+  std::string named;
+  if (!file || !std::getline(file, named) || named.empty()) return std::nullopt;
+  const fs::path path = fs::path(named).is_absolute() ? fs::path(named) : fs::path(run_dir) / named;
+  if (!fs::is_regular_file(path)) return std::nullopt;
+  return path.string();
+}
+
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
                                    std::ostream& out, bool keep_iterates) {
   if (ctx.rc.finetune.iterations <= 0) return policy_path;
+  record_finetune_start(ctx.run_dir, policy_path, out);
   // The quick evaluation's way-points, and half as many again facing a random heading.
   const eval::QuickEvaluator validation(ctx.model, ctx.rc.task, ctx.rc.run.best_eval_suite,
                                         ctx.rc.run.best_eval_suite / 2);

@@ -60,8 +60,18 @@ struct FinetuneStageInput {
 std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
                            std::ostream& out);
 
-/// Runs the fine-tuning stage when configured (keep_iterates: FinetuneStageInput's); on a failure
-/// keeps policy_path. Returns the path of the policy to evaluate.
+/// The file in a run directory that names the policy its fine-tuning started from: relative to
+/// the run directory when inside it, so that the run can be moved.
+inline constexpr const char* kFinetuneStartFile = "finetune_start.txt";
+
+/// The policy run_dir's fine-tuning started from (RUN/finetune_start.txt), when the file names
+/// one that exists; nullopt otherwise (a run that was not fine-tuned, or older than the file).
+std::optional<std::string> finetune_start(const std::string& run_dir);
+
+/// Runs the fine-tuning stage when configured (keep_iterates: FinetuneStageInput's), first
+/// recording policy_path in RUN/finetune_start.txt (a record: when it cannot be written the
+/// stage says so and goes on); on a failure keeps policy_path. Returns the path of the policy
+/// to evaluate.
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
                                    std::ostream& out, bool keep_iterates = false);
 

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include "launcher/launcher.hpp"
@@ -16,11 +17,22 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The policy the run's evaluation named (eval/selected_policy.txt), else RUN/policy.nn.
-std::string run_policy(const std::string& run_dir) {
+/// The policy to fine-tune when none is given: the one the run's own fine-tuning started from
+/// (RUN/finetune_start.txt), so that the new search is comparable with the run's and, with the
+/// run's settings and seed, repeats it; for a run that was not fine-tuned, the one its evaluation
+/// named (eval/selected_policy.txt); else RUN/policy.nn.
+std::string run_policy(const std::string& run_dir, std::ostream& out) {
+  if (std::optional<std::string> start = finetune_start(run_dir)) {
+    out << "auvrl finetune: from the policy the run's fine-tuning started from ("
+        << kFinetuneStartFile << ")\n";
+    return *start;
+  }
   std::ifstream named(fs::path(run_dir) / "eval" / "selected_policy.txt");
   std::string path;
-  if (named && std::getline(named, path) && fs::exists(path)) return path;
+  if (named && std::getline(named, path) && fs::exists(path)) {
+    out << "auvrl finetune: from the policy the run's evaluation used (eval/selected_policy.txt)\n";
+    return path;
+  }
   return (fs::path(run_dir) / "policy.nn").string();
 }
 
@@ -31,7 +43,7 @@ int refinetune(const RefinetuneOptions& o, std::ostream& out) {
   if (!fs::exists(run_config)) {
     throw std::invalid_argument(o.run_dir + " has no config.yaml: not an `auvrl train` run");
   }
-  const std::string policy = o.policy_path.empty() ? run_policy(o.run_dir) : o.policy_path;
+  const std::string policy = o.policy_path.empty() ? run_policy(o.run_dir, out) : o.policy_path;
   if (!fs::exists(policy)) throw std::invalid_argument(policy + " not found");
   if (directory_in_use(o.out_dir)) {
     throw std::invalid_argument(o.out_dir + " already exists and is not empty");

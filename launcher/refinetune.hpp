@@ -15,10 +15,12 @@ namespace auvrl::launcher {
 struct RefinetuneOptions {
   std::string run_dir;      ///< the trained run: its config.yaml (task, vehicle) and policy
   std::string config_path;  ///< "": the run's config.yaml; else its finetune: section is used
-  std::string policy_path;  ///< "": the policy the run's evaluation named, else RUN/policy.nn
-  std::string out_dir;      ///< created (or empty): finetune.csv, policy_finetuned.nn, eval/
-  int iterations = -1;      ///< overrides finetune.iterations when >= 0
-  int candidates = 0;       ///< overrides finetune.candidates when >= 1
+  /// "": the policy the run's fine-tuning started from (RUN/finetune_start.txt), else the one
+  /// its evaluation named (eval/selected_policy.txt), else RUN/policy.nn.
+  std::string policy_path;
+  std::string out_dir;  ///< created (or empty): finetune.csv, policy_finetuned.nn, eval/
+  int iterations = -1;  ///< overrides finetune.iterations when >= 0
+  int candidates = 0;   ///< overrides finetune.candidates when >= 1
   /// The fine-tuning's seed (its way-points) when >= 0; else the run's: the seed its command
   /// line gave (command_line.yaml), or its configuration's run.seed.
   std::int64_t seed = -1;

@@ -73,6 +73,8 @@ void write_readme(const std::string& run_dir) {
         << "  checkpoints/      learner checkpoints (auvrl train --resume " << run_dir << ")\n"
         << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
         << "  policy_finetuned.nn, finetune.csv   the fine-tuned policy and its progress\n"
+        << "  finetune_start.txt   the policy the fine-tuning started from (auvrl finetune\n"
+           "                    --run-dir starts there again)\n"
         << "  objective_terms.csv   the fine-tuning's objective by price: PID, trained, kept\n"
         << "  candidates.csv, finetune_candidateK.csv   with finetune.candidates > 1: each\n"
            "                    search's robustness groups, the one kept, and its progress\n"

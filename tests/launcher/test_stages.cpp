@@ -173,6 +173,68 @@ TEST(RefinetuneTest, FineTunesARunsPolicyAgainAndEvaluatesIt) {
   EXPECT_THROW(refinetune(o, again), std::invalid_argument);
 }
 
+// The run's fine-tuning records the policy it started from, relative to the run directory (so
+// the run can be moved), and `auvrl finetune` without --policy starts from it, not from the
+// fine-tuned policy the evaluation used: with the run's settings and seed the search repeats
+// the run's own. A record naming no file is passed over.
+TEST(RefinetuneTest, StartsFromThePolicyTheRunsFineTuningStartedFrom) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  const TrainOptions options = fast_run_directory(tmp);
+  const std::string start = (tmp / "run" / "policy_best.nn").string();
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", start);
+  RunContext ctx = load_run_context(options, ContextUse::kAfterTraining);
+  ctx.rc.finetune.iterations = 2;
+  std::ostringstream trained;
+  finetune_if_configured(ctx, start, trained, false);
+  EXPECT_EQ(test_support::read_text(tmp / "run" / kFinetuneStartFile), "policy_best.nn\n");
+  fs::rename(tmp / "run", tmp / "moved");
+  // The evaluation named another policy (other weights), as a run's does after its fine-tuning.
+  const std::string evaluated = (tmp / "moved" / "policy_finetuned_elsewhere.nn").string();
+  nn::Mlp other =
+      nn::network_from_bytes(nn::read_file((tmp / "moved" / "policy_best.nn").string()), 1);
+  other.params() *= 0.9f;
+  nn::save_network_file(evaluated, other);
+  std::ofstream(tmp / "moved" / "eval" / "selected_policy.txt") << evaluated << "\n";
+  ASSERT_EQ(finetune_start((tmp / "moved").string()), (tmp / "moved" / "policy_best.nn").string());
+
+  RefinetuneOptions o;
+  o.run_dir = (tmp / "moved").string();
+  o.out_dir = (tmp / "again").string();
+  o.iterations = 2;
+  std::ostringstream out;
+  ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  EXPECT_NE(out.str().find("auvrl finetune: " + (tmp / "moved" / "policy_best.nn").string()),
+            std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("the policy the run's fine-tuning started from"), std::string::npos);
+  // Each iteration's objective (the second column), the same in both searches.
+  const auto objectives = [](const fs::path& csv) {
+    std::vector<std::string> column;
+    std::ifstream in(csv);
+    for (std::string line; std::getline(in, line);) {
+      const std::size_t from = line.find(',') + 1;
+      column.push_back(line.substr(from, line.find(',', from) - from));
+    }
+    return column;
+  };
+  const std::vector<std::string> first = objectives(tmp / "moved" / "finetune.csv");
+  ASSERT_EQ(first.size(), 3u);  // the header and two iterations
+  EXPECT_EQ(objectives(tmp / "again" / "finetune.csv"), first);
+  // Outside the new directory, its record is absolute.
+  EXPECT_EQ(test_support::read_text(tmp / "again" / kFinetuneStartFile),
+            (tmp / "moved" / "policy_best.nn").string() + "\n");
+
+  // Without the file it names, the evaluation's policy.
+  fs::remove(tmp / "moved" / "policy_best.nn");
+  EXPECT_EQ(finetune_start((tmp / "moved").string()), std::nullopt);
+  o.out_dir = (tmp / "third").string();
+  std::ostringstream third;
+  ASSERT_EQ(refinetune(o, third), 0) << third.str();
+  EXPECT_NE(third.str().find("the policy the run's evaluation used"), std::string::npos)
+      << third.str();
+  EXPECT_NE(third.str().find("auvrl finetune: " + evaluated), std::string::npos) << third.str();
+}
+
 // objective_terms.csv is a report: when it cannot be written the stage says so and goes on,
 // the fine-tuning's result as it would be otherwise.
 TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
