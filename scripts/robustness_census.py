@@ -5,7 +5,8 @@ which criteria: where a method loses its groups on average, rather than on one d
 
 Each argument is a robustness_comparison.csv file, a directory holding one, or a run directory
 (its eval/robustness_comparison.csv). Prints the comparisons read, the mean number of groups
-passing, then one line per group that failed anywhere: in how many comparisons it failed and
+passing, in how many comparisons every group passes (how often one run meets a bar of every
+group at one draw), then one line per group that failed anywhere: in how many comparisons it failed and
 how often each criterion did (a group can fail several at once), most failures first. With
 --out, the same as CSV: group, comparisons, failed, then one column per criterion.
 
@@ -84,6 +85,8 @@ def main():
     passing = [sum(1 for _, passes, _ in groups if passes) for groups in comparisons]
     print(f'{len(comparisons)} comparisons; groups passing: mean {sum(passing) / len(passing):.2f} '
           f'of {len(comparisons[0])} (min {min(passing)}, max {max(passing)})')
+    every = sum(1 for n in passing if n == len(comparisons[0]))
+    print(f'every group passes in {every} of {len(comparisons)} comparisons')
     ordered = sorted(table.items(), key=lambda item: (-item[1][1], item[0]))
     for group, (seen, failed, by_criterion) in ordered:
         if failed == 0:

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """scripts/robustness_census.py on fabricated comparison files: the groups passing and the
-failures per group and criterion add up as written, a file, its folder and a run directory are
-read alike, and a missing file, a missing column, a bad cell and another suite's groups are named.
+failures per group and criterion add up as written, the comparisons where every group passes
+are counted, a file, its folder and a run directory are read alike, and a missing file, a
+missing column, a bad cell and another suite's groups are named.
 
 Usage: test_robustness_census.py SCRIPT
 """
@@ -54,6 +55,7 @@ with tempfile.TemporaryDirectory() as tmp:
     check(done.returncode == 0, f'three comparisons: exit {done.returncode}: {done.stderr}')
     text = done.stdout
     check('3 comparisons; groups passing: mean 1.67 of 3 (min 1, max 2)' in text, text)
+    check('every group passes in 0 of 3 comparisons' in text, text)
     lines = {line.split()[0]: ' '.join(line.split()[1:]) for line in text.splitlines()[1:]}
     check(lines.get('t6_0pct') == 'failed 3 of 3: held 1, time 2, hold 2', text)
     check(lines.get('sensor_noise') == 'failed 1 of 3: energy 1', text)
@@ -65,6 +67,11 @@ with tempfile.TemporaryDirectory() as tmp:
                       'hold', 'smoothness'], f'header {rows[0]}')
     check(rows[1] == ['t6_0pct', '3', '3', '1', '0', '2', '0', '2', '0'], f'row {rows[1]}')
     check(rows[3] == ['rest_start', '3', '0', '0', '0', '0', '0', '0', '0'], f'row {rows[3]}')
+
+    all_pass = os.path.join(tmp, 'all_pass.csv')
+    write(all_pass, [row('rest_start'), row('t6_0pct'), row('sensor_noise')])
+    done = run(all_pass, a, all_pass)
+    check('every group passes in 2 of 3 comparisons' in done.stdout, done.stdout)
 
     done = run(os.path.join(tmp, 'nothing'))
     check(done.returncode != 0 and 'nothing: no robustness_comparison.csv' in done.stderr,
