@@ -304,13 +304,17 @@ void record_finetune_start(const std::string& run_dir, const std::string& start_
 
 }  // namespace
 
-std::optional<std::string> finetune_start(const std::string& run_dir) {
-  std::ifstream file(fs::path(run_dir) / kFinetuneStartFile);
+std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {
+  std::ifstream file(fs::path(run_dir) / record);
   std::string named;
   if (!file || !std::getline(file, named) || named.empty()) return std::nullopt;
   const fs::path path = fs::path(named).is_absolute() ? fs::path(named) : fs::path(run_dir) / named;
   if (!fs::is_regular_file(path)) return std::nullopt;
   return path.string();
+}
+
+std::optional<std::string> finetune_start(const std::string& run_dir) {
+  return policy_named_in(run_dir, kFinetuneStartFile);
 }
 
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
@@ -349,7 +353,7 @@ EvaluationResult evaluate_stage(const RunContext& ctx, const std::string& policy
   auto pid = eval::make_eval_controller(pid_request, ctx.model, pid_config);
   result.pid_rows =
       eval::run_evaluation(ctx.model, pid_config, *pid, all, (eval_dir / "pid").string());
-  std::ofstream(eval_dir / "selected_policy.txt") << policy_path << "\n";
+  std::ofstream(fs::path(ctx.run_dir) / kSelectedPolicyFile) << policy_path << "\n";
   try {
     const eval::RobustnessResult p =
         eval::run_robustness(ctx.model, config, policy, eval::kRobustnessEpisodesPerGroup,

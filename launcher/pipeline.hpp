@@ -64,6 +64,13 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 /// the run directory when inside it, so that the run can be moved.
 inline constexpr const char* kFinetuneStartFile = "finetune_start.txt";
 
+/// The file in a run directory that names the policy its evaluation used.
+inline constexpr const char* kSelectedPolicyFile = "eval/selected_policy.txt";
+
+/// The policy that the record file `record` (relative to run_dir) names on its first line, a
+/// relative name resolved against run_dir, when that policy file exists; nullopt otherwise.
+std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record);
+
 /// The policy run_dir's fine-tuning started from (RUN/finetune_start.txt), when the file names
 /// one that exists; nullopt otherwise (a run that was not fine-tuned, or older than the file).
 std::optional<std::string> finetune_start(const std::string& run_dir);

@@ -1,7 +1,6 @@
 #include "launcher/refinetune.hpp"
 
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <stdexcept>
 
@@ -27,11 +26,10 @@ std::string run_policy(const std::string& run_dir, std::ostream& out) {
         << kFinetuneStartFile << ")\n";
     return *start;
   }
-  std::ifstream named(fs::path(run_dir) / "eval" / "selected_policy.txt");
-  std::string path;
-  if (named && std::getline(named, path) && fs::exists(path)) {
-    out << "auvrl finetune: from the policy the run's evaluation used (eval/selected_policy.txt)\n";
-    return path;
+  if (std::optional<std::string> evaluated = policy_named_in(run_dir, kSelectedPolicyFile)) {
+    out << "auvrl finetune: from the policy the run's evaluation used (" << kSelectedPolicyFile
+        << ")\n";
+    return *evaluated;
   }
   return (fs::path(run_dir) / "policy.nn").string();
 }

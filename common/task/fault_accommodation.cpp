@@ -53,7 +53,7 @@ void ThrusterFaultAccommodation::reset() {
   solver_ = Eigen::LDLT<Eigen::MatrixXd>(n);
   replica_delayed_n_ = replica_n_ = Eigen::VectorXd::Zero(n);
   moment_realised_replica_ = moment_replica_squared_ = Eigen::VectorXd::Zero(n);
-  efficiency_ = share_ = healthy_ = Eigen::VectorXd::Ones(n);
+  efficiency_ = healthy_ = Eigen::VectorXd::Ones(n);
   condition_.assign(static_cast<std::size_t>(n), Condition::kHealthy);
   any_faulty_ = false;
 }
@@ -103,8 +103,6 @@ bool ThrusterFaultAccommodation::classify(int i) {
   } else if (before == Condition::kHealthy && efficiency_[i] < s.weak_below) {
     condition_[k] = Condition::kWeak;
   }
-  if (condition_[k] == Condition::kWeak) share_[i] = efficiency_[i];
-  if (condition_[k] == Condition::kDead) share_[i] = 0.0;
   return condition_[k] != before;
 }
 
@@ -120,7 +118,14 @@ void ThrusterFaultAccommodation::factorise() {
 
 void ThrusterFaultAccommodation::redistribute(ActionVector& action) {
   command_ = action.cast<double>();  // normalised: the scale cancels
-  shortfall_ = (1.0 - share_.array()) * command_.array();
+  // Each thruster's share s of its command: 1 healthy, its estimate when weak, 0 dead.
+  for (int i = 0; i < task_.num_thrusters; ++i) {
+    const Condition c = condition_[static_cast<std::size_t>(i)];
+    const double share = c == Condition::kHealthy ? 1.0
+                         : c == Condition::kWeak  ? efficiency_[i]
+                                                  : 0.0;
+    shortfall_[i] = (1.0 - share) * command_[i];
+  }
   rhs_.noalias() = wrench_gram_ * shortfall_;
   rhs_ = healthy_.cwiseProduct(rhs_);
   makeup_ = solver_.solve(rhs_);

@@ -58,8 +58,7 @@ class ThrusterFaultAccommodation {
 
  private:
   enum class Condition { kHealthy, kWeak, kDead };
-  /// Updates the efficiency estimates and the weak thrusters' shares; true if a thruster was
-  /// found weak or dead this step.
+  /// Updates the efficiency estimates; true if a thruster was found weak or dead this step.
   bool estimate(const Eigen::Ref<const StateVector>& state);
   /// Marks thruster i weak or dead as its estimate says; true if its condition changed.
   bool classify(int i);
@@ -78,7 +77,6 @@ class ThrusterFaultAccommodation {
   Eigen::VectorXd moment_realised_replica_, moment_replica_squared_;
   Eigen::VectorXd efficiency_;
   std::vector<Condition> condition_;
-  Eigen::VectorXd share_;                ///< s: 1 healthy, the estimate when weak, 0 dead
   Eigen::VectorXd healthy_;              ///< H's diagonal
   bool any_faulty_ = false;              ///< some thruster is weak or dead
   Eigen::MatrixXd system_;               ///< H B'B H + lambda I
