@@ -8,8 +8,7 @@ Each argument is a robustness_comparison.csv file, a directory holding one, or a
 passing, in how many comparisons every group passes (how often one run meets a bar of every
 group at one draw), then one line per group that failed anywhere: in how many comparisons it
 failed and how often each criterion did (a group can fail several at once), most failures
-first. With
---out, the same as CSV: group, comparisons, failed, then one column per criterion.
+first. With --out, the same as CSV: group, comparisons, failed, then one column per criterion.
 
 Usage: scripts/robustness_census.py COMPARISON [COMPARISON ...] [--out CSV]
 """
