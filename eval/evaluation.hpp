@@ -76,6 +76,9 @@ struct EvaluationConfig {
   /// Every episode runs this many control steps (700 = 70 s), whatever task.max_steps the
   /// policy was trained with (shorter training episodes must not shorten the evaluation).
   int episode_steps = 700;
+  /// The robustness suite adds the facing_away group (eval/robustness.hpp) after its own: the
+  /// pipeline's choice among fine-tuning candidates scores it; the bar's suite does not.
+  bool robustness_facing_away = false;
 };
 
 /// One episode of a scenario: where it starts, where it goes, what is broken.
@@ -210,6 +213,8 @@ struct EvalRequest {
   /// also compared with the PID baseline on the same episodes.
   int robustness_episodes = 20;
   bool robustness_with_pid = false;
+  /// and whether the suite adds the facing_away group (EvaluationConfig::robustness_facing_away).
+  bool robustness_facing_away = false;
 };
 
 /// Builds the controller for a request: loads and checks the policy file (errors name the

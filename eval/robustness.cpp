@@ -152,6 +152,10 @@ EvaluationEpisode draw_episode(const EvaluationConfig& config, int num_thrusters
   const double yaw_rad = uniform(rng, -kPi, kPi);
   draw_start(config.task, g.draw.start, yaw_rad, rng, e.start);
   draw_goal(config.task, g.draw.goal, rng, e);
+  if (g.draw.facing_away) {
+    const Eigen::Vector3d to_goal = e.goal_ned_m - e.start.position_ned_m;
+    e.start.euler_rpy_rad[2] = std::remainder(std::atan2(to_goal[1], to_goal[0]) + kPi, 2 * kPi);
+  }
   if (g.draw.start == StartDraw::kAnywhere || g.draw.goal == GoalDraw::kFar) {
     e.safety_radius_m = grown_safety_radius_m(config.task, e.start.position_ned_m, e.goal_ned_m);
   }
@@ -181,7 +185,8 @@ double grown_safety_radius_m(const task::TaskConfig& task, const Eigen::Vector3d
 }
 
 std::vector<RobustnessGroup> robustness_groups(int num_thrusters,
-                                               const std::vector<std::string>& thruster_names) {
+                                               const std::vector<std::string>& thruster_names,
+                                               bool with_facing_away) {
   std::vector<RobustnessGroup> groups;
   groups.push_back(group("rest_start", "at rest at the start position, way-point in the region"));
   GroupDraw any;
@@ -246,6 +251,14 @@ std::vector<RobustnessGroup> robustness_groups(int num_thrusters,
   v = {};
   v.extra_buoyancy_n = 2.0 * kGravityMps2;
   groups.push_back(model_group("buoyancy_+2kg", "2 kg of extra buoyancy (19.62 N)", v));
+  if (with_facing_away) {
+    GroupDraw away;
+    away.facing_away = true;
+    groups.push_back(group("facing_away",
+                           "at rest at the start position, the way-point in the region straight "
+                           "behind (not one of the bar's groups)",
+                           away));
+  }
   return groups;
 }
 
@@ -263,7 +276,8 @@ std::vector<EvaluationEpisode> robustness_episodes(const EvaluationConfig& confi
         farthest_region_corner_m(config.task), kRobustnessFarMaxM));
   }
   std::vector<EvaluationEpisode> episodes;
-  for (const RobustnessGroup& g : robustness_groups(num_thrusters)) {
+  for (const RobustnessGroup& g :
+       robustness_groups(num_thrusters, {}, config.robustness_facing_away)) {
     const std::uint64_t group_seed = splitmix64(seed ^ fnv1a64(g.name));
     for (int i = 0; i < episodes_per_group; ++i) {
       episodes.push_back(draw_episode(config, num_thrusters, g, i, group_seed));
@@ -492,15 +506,38 @@ std::string robustness_margins_markdown(const std::vector<GroupMargins>& margins
   return out;
 }
 
-RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
-                                agent::Controller& controller, int episodes_per_group,
-                                std::uint64_t seed, const std::string& out_dir) {
+std::vector<EvaluationEpisode> facing_away_episodes(const EvaluationConfig& config,
+                                                    int num_thrusters, int count,
+                                                    std::uint64_t seed) {
+  if (count < 0) throw std::invalid_argument("facing_away_episodes: count must be >= 0");
+  const RobustnessGroup away = robustness_groups(num_thrusters, {}, true).back();
+  const std::uint64_t group_seed = splitmix64(seed ^ fnv1a64(away.name));
+  std::vector<EvaluationEpisode> episodes;
+  for (int i = 0; i < count; ++i) {
+    episodes.push_back(draw_episode(config, num_thrusters, away, i, group_seed));
+  }
+  return episodes;
+}
+
+std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
+                                           agent::Controller& controller,
+                                           const std::vector<EvaluationEpisode>& episodes) {
   task::apply_vehicle(model.facts(), config.task);
   config.task.max_steps = config.episode_steps;  // checked here; each episode applies it
   config.task.validate();
   if (!(config.reach_radius_m > 0)) {
     throw std::invalid_argument("robustness: reach radius must be > 0");
   }
+  std::vector<SummaryRow> rows;
+  for (const EvaluationEpisode& episode : episodes) {
+    rows.push_back(run_evaluation_episode(model, config, controller, episode, nullptr));
+  }
+  return rows;
+}
+
+RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
+                                agent::Controller& controller, int episodes_per_group,
+                                std::uint64_t seed, const std::string& out_dir) {
   if (!out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
@@ -509,9 +546,7 @@ RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig
   RobustnessResult result;
   result.episodes = robustness_episodes(config, model.num_thrusters(), episodes_per_group, seed);
   const auto started = std::chrono::steady_clock::now();
-  for (const EvaluationEpisode& episode : result.episodes) {
-    result.rows.push_back(run_evaluation_episode(model, config, controller, episode, nullptr));
-  }
+  result.rows = run_drawn_episodes(model, config, controller, result.episodes);
   result.elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   result.groups = group_metrics(result.rows, config.reach_radius_m);
@@ -520,7 +555,8 @@ RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig
     write_robustness_episodes_csv((dir / "robustness_episodes.csv").string(), result.episodes,
                                   result.rows, model.num_thrusters());
     write_robustness_csv((dir / "robustness.csv").string(), result.groups,
-                         robustness_groups(model.num_thrusters(), model.facts().thruster_names));
+                         robustness_groups(model.num_thrusters(), model.facts().thruster_names,
+                                           config.robustness_facing_away));
     write_vehicle_csv((dir / "vehicle.csv").string(), model.facts());
   }
   return result;
@@ -736,6 +772,7 @@ RobustnessResult run_robustness_request(const EvalRequest& request, std::ostream
   const sim::VehicleModel model = sim::load_vehicle_file(request.vehicle_path);
   EvaluationConfig config;
   config.seed = request.seed;
+  config.robustness_facing_away = request.robustness_facing_away;
   std::unique_ptr<agent::Controller> controller = make_eval_controller(request, model, config);
   out << "vehicle " << describe(model.facts()) << "\n";
   if (request.controller == "pid" || request.robustness_with_pid) {

@@ -105,6 +105,9 @@ struct GroupDraw {
   double varying_time_constant_s = 30;
   sim::SensorNoise sensor_noise;        ///< on what the vehicle reports
   sim::ModelVariation model_variation;  ///< how the vehicle differs from its file
+  /// The start heading turned so that the way-point lies straight behind (horizontally): the
+  /// body-frame goal error then says nothing of which way to turn.
+  bool facing_away = false;
 };
 
 /// One group of the suite: its name (robustness.csv's `group`), what it tests, its draw.
@@ -115,9 +118,14 @@ struct RobustnessGroup {
 };
 
 /// The groups in the suite's order (see the file comment) for a vehicle with num_thrusters
-/// thrusters; thruster_names (one per thruster, may be empty) only label the descriptions.
+/// thrusters; thruster_names (one per thruster, may be empty) only label the descriptions. With
+/// with_facing_away, the group facing_away follows them (at rest at the start position, the
+/// way-point in the region straight behind): not one of the bar's groups, but scored where the
+/// pipeline chooses among fine-tuning candidates, since a search may learn to back towards such
+/// a way-point for seconds before it turns.
 std::vector<RobustnessGroup> robustness_groups(int num_thrusters,
-                                               const std::vector<std::string>& thruster_names = {});
+                                               const std::vector<std::string>& thruster_names = {},
+                                               bool with_facing_away = false);
 
 /// The suite's episodes, group after group, episodes_per_group each, drawn from config.task's
 /// training region and start position (see the file comment for the streams). Each has
@@ -246,6 +254,21 @@ struct RobustnessResult {
   std::vector<GroupMetrics> groups;
   double elapsed_s = 0.0;  ///< wall-clock time of the episodes
 };
+
+/// count episodes of the group facing_away (robustness_groups with with_facing_away), drawn as
+/// the suite draws that group at seed (its first episodes are the suite's). Throws
+/// std::invalid_argument for a negative count.
+std::vector<EvaluationEpisode> facing_away_episodes(const EvaluationConfig& config,
+                                                    int num_thrusters, int count,
+                                                    std::uint64_t seed);
+
+/// Runs drawn episodes one after another (deterministic), the config's task given the model's
+/// thruster count and maximum thrust and config.episode_steps steps each; one row per episode,
+/// in their order. Throws std::invalid_argument for a task that does not validate or a reach
+/// radius that is not > 0.
+std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
+                                           agent::Controller& controller,
+                                           const std::vector<EvaluationEpisode>& episodes);
 
 /// Runs the suite (one episode after another: deterministic) and, with a non-empty out_dir,
 /// creates it and writes robustness_episodes.csv, robustness.csv and vehicle.csv; throws

@@ -77,6 +77,9 @@ int run_eval(int argc, const char* const* argv) {
   cli.flag("with-pid", &request.robustness_with_pid,
            "robustness: also run the PID on the same episodes (DIR/pid/) and write "
            "DIR/robustness_comparison.md and .csv");
+  cli.flag("facing-away-group", &request.robustness_facing_away,
+           "robustness: add the group facing_away (way-points straight behind a start at rest; "
+           "scored where the pipeline chooses among fine-tuning candidates, not one of the bar's)");
   if (!cli.parse(argc, argv)) return 0;
   request.seed = static_cast<std::uint64_t>(seed);
   if (!request.mission_path.empty()) {

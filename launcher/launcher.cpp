@@ -1,5 +1,7 @@
 #include "launcher/launcher.hpp"
 
+#include <chrono>
+
 #include "launcher/namespace_exec.hpp"
 #include "launcher/pipeline.hpp"
 #include "launcher/run_signing.hpp"
@@ -9,6 +11,7 @@ namespace auvrl::launcher {
 
 int run_training(const TrainOptions& options, std::ostream& out) {
   out << std::unitbuf;  // progress and supervision lines must reach a log file as they happen
+  const auto training_start = std::chrono::steady_clock::now();
   const RunContext ctx = load_run_context(options);
   // Made before training, so that a full disk or a read-only run stops it at once.
   const std::string key = ensure_run_key(ctx.run_dir);
@@ -23,7 +26,7 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     out << "auvrl train: no policy was written; nothing to fine-tune or evaluate\n";
     return 1;
   }
-  const std::string policy_path = finetune_if_configured(ctx, *selected, out);
+  const std::string policy_path = finetune_if_configured(ctx, *selected, out, false, training_start);
   sign_policies(ctx.run_dir, key, out);
   if (!options.evaluate) return 0;
   const EvaluationResult evaluation = evaluate_stage(ctx, policy_path, out);

@@ -2,9 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -213,15 +216,22 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
   return CandidateSearch{seed, std::move(best), std::move(result)};
 }
 
+/// Seconds from `since` to now.
+double seconds_since(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
 /// Runs every candidate's search and returns the one to keep: with one, it; with more, the one
-/// whose kept weights (or the start, where a search kept none) pass the most robustness groups
-/// at the selection seed (candidates.csv has each). A search that fails after the first is
+/// whose kept weights (or the start, where a search kept none) pass the most criteria at the
+/// selection seed (tuning::choose_candidate; candidates.csv has each). A search that fails after the first is
 /// said and the choice made among those done; Ctrl-C ends the searches after the one under way.
 CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
                                   const eval::ValidationScore& before, std::ostream& out) {
   if (in.config.candidates == 1) return search_candidate(in, start, before, 0, out);
+  const auto stage_start = std::chrono::steady_clock::now();
   const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
   std::vector<CandidateSearch> searches;
+  std::vector<tuning::CandidateScore> scores;
   std::vector<CandidatesRow> rows;
   for (int index = 0; index < in.config.candidates; ++index) {
     if (index > 0 && signals::stop_requested()) break;
@@ -234,18 +244,24 @@ CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& s
       break;
     }
     const CandidateSearch& c = searches.back();
-    const int passing = selector.groups_passing(c.best.net ? *c.best.net : start);
-    rows.push_back({index + 1, c.seed, c.best.iteration, c.result.best_objective, passing,
-                    selector.groups(), false});
+    const tuning::CandidateScore score = selector.score(c.best.net ? *c.best.net : start);
+    scores.push_back(score);
+    rows.push_back({index + 1, c.seed, c.best.iteration, c.result.best_objective,
+                    score.groups_passing, selector.groups(), score.behind_late,
+                    score.behind_episodes, false});
     out << fmt::format(
         "auvrl train: fine-tuning candidate {}/{} (seed {}): objective {:.3f} s, {} of {} "
-        "robustness groups at seed {}\n",
-        index + 1, in.config.candidates, c.seed, c.result.best_objective, passing,
-        selector.groups(), in.config.selection_seed);
+        "robustness groups at seed {}, late on {} of {} way-points straight behind\n",
+        index + 1, in.config.candidates, c.seed, c.result.best_objective, score.groups_passing,
+        selector.groups(), in.config.selection_seed, score.behind_late, score.behind_episodes);
+    const double training_s = seconds_since(in.training_start);
+    if (const auto why = no_further_candidate(in.config, in.reproducible, training_s,
+                                              seconds_since(stage_start), index + 1)) {
+      out << "auvrl train: fine-tuning: " << *why << "\n";
+      break;
+    }
   }
-  std::vector<int> passing;
-  for (const CandidatesRow& r : rows) passing.push_back(r.groups_passing);
-  const std::size_t chosen = tuning::choose_candidate(passing);
+  const std::size_t chosen = tuning::choose_candidate(scores);
   rows[chosen].chosen = true;
   const std::string path = (fs::path(in.run_dir) / "candidates.csv").string();
   try {
@@ -304,6 +320,20 @@ void record_finetune_start(const std::string& run_dir, const std::string& start_
 
 }  // namespace
 
+std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
+                                                bool reproducible, double training_s,
+                                                double searches_s, int done) {
+  if (done >= config.candidates || reproducible || !(config.candidates_within_s > 0)) {
+    return std::nullopt;
+  }
+  const double next_end_s = training_s + searches_s / done;
+  if (next_end_s <= config.candidates_within_s) return std::nullopt;
+  return fmt::format(
+      "{} of {} candidates searched after {:.1f} s of training; another would end at about "
+      "{:.1f} s, past finetune.candidates_within_s ({:g} s): choosing among these",
+      done, config.candidates, training_s, next_end_s, config.candidates_within_s);
+}
+
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {
   std::ifstream file(fs::path(run_dir) / record);
   std::string named;
@@ -318,7 +348,8 @@ std::optional<std::string> finetune_start(const std::string& run_dir) {
 }
 
 std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
-                                   std::ostream& out, bool keep_iterates) {
+                                   std::ostream& out, bool keep_iterates,
+                                   std::chrono::steady_clock::time_point training_start) {
   if (ctx.rc.finetune.iterations <= 0) return policy_path;
   record_finetune_start(ctx.run_dir, policy_path, out);
   // The quick evaluation's way-points, and half as many again facing a random heading.
@@ -326,7 +357,8 @@ std::string finetune_if_configured(const RunContext& ctx, const std::string& pol
                                         ctx.rc.run.best_eval_suite / 2);
   try {
     return finetune_stage({ctx.model, ctx.rc.task, ctx.rc.finetune, ctx.rc.run.seed, validation,
-                           ctx.rc.run.best_eval_max_hold_m, ctx.run_dir, keep_iterates},
+                           ctx.rc.run.best_eval_max_hold_m, ctx.run_dir, keep_iterates,
+                           ctx.rc.run.reproducible, training_start},
                           policy_path, out);
   } catch (const std::exception& e) {
     // The trained policy stays: a failed fine-tuning (a full disk, say) loses nothing.

@@ -2,6 +2,7 @@
 // evaluate (the policy and the PID baseline) -> report (plots, summary tables).
 #pragma once
 
+#include <chrono>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -46,6 +47,11 @@ struct FinetuneStageInput {
   /// candidate K's to iterates_candidateK/), for evaluating how the fine-tuning went beyond what
   /// it keeps.
   bool keep_iterates = false;
+  /// A reproducible run: every candidate is searched whatever finetune.candidates_within_s says.
+  bool reproducible = false;
+  /// When the training began (its TD3 phase, or `auvrl finetune`): finetune.candidates_within_s
+  /// counts from here.
+  std::chrono::steady_clock::time_point training_start = std::chrono::steady_clock::now();
 };
 
 /// Fine-tunes the policy at start_path (progress to finetune.csv) and returns the path of the
@@ -53,12 +59,22 @@ struct FinetuneStageInput {
 /// iterations and at the end; the best of them, if better than the start there, is written to
 /// policy_finetuned.nn and kept. (The fine-tuning's own way-points are few: a step that lowers
 /// their objective can lose a way-point elsewhere.) With finetune.candidates > 1 the searches
-/// run one after another (candidate K's progress to finetune_candidateK.csv), and the one whose
-/// kept weights pass the most robustness groups at finetune.selection_seed is kept
-/// (candidates.csv; tuning/candidate_selection.hpp). Ctrl-C ends it after the iteration under
+/// run one after another (candidate K's progress to finetune_candidateK.csv; an asynchronous run
+/// starts no further one that would end past finetune.candidates_within_s), and the one whose
+/// kept weights pass the most criteria at finetune.selection_seed is kept (candidates.csv;
+/// tuning::choose_candidate). Ctrl-C ends it after the iteration under
 /// way.
 std::string finetune_stage(const FinetuneStageInput& in, const std::string& start_path,
                            std::ostream& out);
+
+/// Why the fine-tuning starts no further candidate after `done` searches, if so: an
+/// asynchronous run whose next search, at the mean pace of the searches so far (searches_s for
+/// the `done` of them), would end past config.candidates_within_s (when > 0) of training
+/// (training_s so far). Nothing when all are done (the loop ends anyway) or in a reproducible
+/// run, whose result must not depend on the machine's speed.
+std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
+                                                bool reproducible, double training_s,
+                                                double searches_s, int done);
 
 /// The file in a run directory that names the policy its fine-tuning started from: relative to
 /// the run directory when inside it, so that the run can be moved.
@@ -78,9 +94,12 @@ std::optional<std::string> finetune_start(const std::string& run_dir);
 /// Runs the fine-tuning stage when configured (keep_iterates: FinetuneStageInput's), first
 /// recording policy_path in RUN/finetune_start.txt (a record: when it cannot be written the
 /// stage says so and goes on); on a failure keeps policy_path. Returns the path of the policy
-/// to evaluate.
-std::string finetune_if_configured(const RunContext& ctx, const std::string& policy_path,
-                                   std::ostream& out, bool keep_iterates = false);
+/// to evaluate. training_start: when the training began (finetune.candidates_within_s counts
+/// from it).
+std::string finetune_if_configured(
+    const RunContext& ctx, const std::string& policy_path, std::ostream& out,
+    bool keep_iterates = false,
+    std::chrono::steady_clock::time_point training_start = std::chrono::steady_clock::now());
 
 /// The evaluation of a policy and of the PID baseline on every scenario and on the robustness
 /// suite.

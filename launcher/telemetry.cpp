@@ -129,10 +129,10 @@ void write_objective_terms(const std::string& path, const std::vector<ObjectiveT
 
 void write_candidates(const std::string& path, const std::vector<CandidatesRow>& rows) {
   csv::Writer writer(path, {"candidate", "seed", "kept_iteration", "objective_s", "groups_passing",
-                            "groups", "chosen"});
+                            "groups", "behind_late", "behind_episodes", "chosen"});
   for (const CandidatesRow& r : rows) {
     writer.row(r.candidate, r.seed, r.kept_iteration, r.objective_s, r.groups_passing, r.groups,
-               r.chosen ? 1 : 0);
+               r.behind_late, r.behind_episodes, r.chosen ? 1 : 0);
   }
   writer.flush();
 }

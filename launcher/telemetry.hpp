@@ -117,6 +117,8 @@ struct CandidatesRow {
   double objective_s = 0.0;  ///< the lowest mean objective its search saw, s
   int groups_passing = 0;    ///< robustness groups passing against the PID at the selection seed
   int groups = 0;            ///< the suite's groups
+  int behind_late = 0;       ///< way-points straight behind reached late (tuning::CandidateScore)
+  int behind_episodes = 0;   ///< of these
   bool chosen = false;       ///< the one kept
 };
 

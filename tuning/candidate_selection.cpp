@@ -37,6 +37,21 @@ void require_validation_seed(std::uint64_t seed, const char* who) {
   }
 }
 
+/// The way-points where `policy` arrives more than kBehindLateMarginS after `pid`, or not at all
+/// where the PID does.
+int late_arrivals(const std::vector<eval::SummaryRow>& policy,
+                  const std::vector<eval::SummaryRow>& pid) {
+  int late = 0;
+  for (std::size_t i = 0; i < policy.size() && i < pid.size(); ++i) {
+    if (!pid[i].reached) continue;
+    if (!policy[i].reached ||
+        policy[i].time_to_reach_s > pid[i].time_to_reach_s + kBehindLateMarginS) {
+      ++late;
+    }
+  }
+  return late;
+}
+
 }  // namespace
 
 std::uint64_t candidate_seed(std::uint64_t run_seed, int index) {
@@ -52,6 +67,9 @@ SuiteSelector::SuiteSelector(const sim::VehicleModel& model, const task::TaskCon
   pid_groups_ =
       eval::run_robustness(model, suite_config(task_, seed_), pid, episodes_per_group_, seed_, "")
           .groups;
+  behind_ = eval::facing_away_episodes(suite_config(task_, seed_), model.num_thrusters(),
+                                       kBehindEpisodes, seed_);
+  pid_behind_ = eval::run_drawn_episodes(model, suite_config(task_, seed_), pid, behind_);
 }
 
 std::vector<eval::GroupComparison> SuiteSelector::compare(const nn::Mlp& policy) const {
@@ -65,11 +83,27 @@ int SuiteSelector::groups_passing(const nn::Mlp& policy) const {
   return passing;
 }
 
-std::size_t choose_candidate(const std::vector<int>& groups_passing) {
-  if (groups_passing.empty()) throw std::invalid_argument("choose_candidate: no candidate");
+CandidateScore SuiteSelector::score(const nn::Mlp& policy) const {
+  CandidateScore s;
+  s.groups_passing = groups_passing(policy);
+  agent::PolicyController controller(policy, task_);
+  s.behind_late = late_arrivals(
+      eval::run_drawn_episodes(model_, suite_config(task_, seed_), controller, behind_),
+      pid_behind_);
+  s.behind_episodes = static_cast<int>(behind_.size());
+  return s;
+}
+
+std::size_t choose_candidate(const std::vector<CandidateScore>& scores) {
+  if (scores.empty()) throw std::invalid_argument("choose_candidate: no candidate");
   std::size_t best = 0;
-  for (std::size_t i = 1; i < groups_passing.size(); ++i) {
-    if (groups_passing[i] > groups_passing[best]) best = i;
+  for (std::size_t i = 1; i < scores.size(); ++i) {
+    const CandidateScore& a = scores[i];
+    const CandidateScore& b = scores[best];
+    if (a.criteria_passing() > b.criteria_passing() ||
+        (a.criteria_passing() == b.criteria_passing() && a.behind_late < b.behind_late)) {
+      best = i;
+    }
   }
   return best;
 }

@@ -20,9 +20,33 @@ namespace auvrl::tuning {
 /// the first candidate is the fine-tuning with one search.
 std::uint64_t candidate_seed(std::uint64_t run_seed, int index);
 
+/// Way-points straight behind a start at rest (the facing_away group of eval/robustness.hpp)
+/// that the choice among candidates draws besides the suite: a search may learn to back towards
+/// such a way-point for seconds before it turns, which the suite's random headings rarely show.
+constexpr int kBehindEpisodes = 100;
+/// A candidate is late on one of them when it arrives more than this after the PID (s), or not
+/// at all where the PID does.
+constexpr double kBehindLateMarginS = 0.3;
+/// The behind criterion passes when at most this fraction of them is late.
+constexpr double kBehindLateFractionMax = 0.1;
+
+/// What the choice among candidates knows of one.
+struct CandidateScore {
+  int groups_passing = 0;   ///< robustness groups passing against the PID
+  int behind_late = 0;      ///< way-points straight behind reached late (kBehindLateMarginS)
+  int behind_episodes = 0;  ///< of these
+  /// At most kBehindLateFractionMax of the way-points straight behind late.
+  bool behind_passes() const {
+    return behind_late <= kBehindLateFractionMax * behind_episodes;
+  }
+  /// The groups passing, plus one when the behind criterion passes.
+  int criteria_passing() const { return groups_passing + (behind_passes() ? 1 : 0); }
+};
+
 /// Scores policies by the robustness groups they pass against the PID baseline
-/// (eval::compare_robustness with the default bar), on the suite drawn at one seed. The PID's
-/// episodes run once, when it is made. The model must outlive it.
+/// (eval::compare_robustness with the default bar), on the suite drawn at one seed, and by how
+/// many of kBehindEpisodes way-points straight behind (drawn at the same seed) they reach late.
+/// The PID's episodes run once, when it is made. The model must outlive it.
 class SuiteSelector {
  public:
   /// Throws std::invalid_argument when seed is the evaluation's own (eval::EvaluationConfig's
@@ -34,6 +58,8 @@ class SuiteSelector {
   std::vector<eval::GroupComparison> compare(const nn::Mlp& policy) const;
   /// The groups the policy passes.
   int groups_passing(const nn::Mlp& policy) const;
+  /// The groups it passes and its way-points straight behind reached late.
+  CandidateScore score(const nn::Mlp& policy) const;
   /// The suite's groups.
   int groups() const { return static_cast<int>(pid_groups_.size()); }
 
@@ -43,11 +69,14 @@ class SuiteSelector {
   std::uint64_t seed_;
   int episodes_per_group_;
   std::vector<eval::GroupMetrics> pid_groups_;
+  std::vector<eval::EvaluationEpisode> behind_;
+  std::vector<eval::SummaryRow> pid_behind_;
 };
 
-/// The candidate to keep: the most groups passing, ties to the earliest. Throws
+/// The candidate to keep: the most criteria passing (CandidateScore::criteria_passing), ties to
+/// the fewest way-points straight behind reached late, then to the earliest. Throws
 /// std::invalid_argument when there is none.
-std::size_t choose_candidate(const std::vector<int>& groups_passing);
+std::size_t choose_candidate(const std::vector<CandidateScore>& scores);
 
 /// The failures (flips and blow-ups) of the policy, driving as the task says, over the
 /// robustness suite drawn at `seed`: a validation draw of the pipeline's own. Throws

@@ -121,9 +121,14 @@ struct FinetuneConfig {
   int threads = 2;  ///< policies evaluated at once (0: one per CPU)
   /// Searches from the same trained policy, one after another, each with a seed of its own
   /// (tuning::candidate_seed: the first is the run's); of their kept weights the pipeline keeps
-  /// those that pass the most robustness groups against the PID at selection_seed
-  /// (tuning/candidate_selection.hpp). 1: one search, no choice.
+  /// those that pass the most criteria at selection_seed: the robustness groups against the PID
+  /// and the way-points straight behind (tuning::choose_candidate). 1: one search, no choice.
   int candidates = 1;
+  /// An asynchronous run's fine-tuning starts a further candidate only when, at the pace of
+  /// those before, it would end within this many seconds of the stage's start (s; 0: no limit),
+  /// so that a slower machine keeps the training's minute with fewer candidates. A reproducible
+  /// run searches them all.
+  double candidates_within_s = 0.0;
   /// The robustness suite's draw that chooses among the candidates, and on which the pipeline's
   /// select stage counts the trained policies' flips: a validation draw of its own, never the
   /// evaluation's (seed 1).

@@ -76,6 +76,48 @@ TEST(RobustnessGroups, EveryThrusterTwiceAndTheOtherGroupsOnce) {
   EXPECT_EQ(robustness_groups(4).size(), 3u + 8u + 10u);
 }
 
+// The group facing_away is not the bar's: only asked for, after the others.
+TEST(RobustnessGroups, FacingAwayOnlyWhenAskedForAndLast) {
+  const std::vector<RobustnessGroup> with = robustness_groups(6, {}, true);
+  ASSERT_EQ(with.size(), 26u);
+  EXPECT_EQ(with.back().name, "facing_away");
+  EXPECT_TRUE(with.back().draw.facing_away);
+  for (const RobustnessGroup& g : robustness_groups(6)) EXPECT_NE(g.name, "facing_away");
+  EvaluationConfig c = config();
+  EXPECT_TRUE(of_group(robustness_episodes(c, 6, 3, 7), "facing_away").empty());
+  c.robustness_facing_away = true;
+  EXPECT_EQ(of_group(robustness_episodes(c, 6, 3, 7), "facing_away").size(), 3u);
+}
+
+// Each starts at rest at the task's start, level, the way-point in the region and straight
+// behind it horizontally; facing_away_episodes draws the suite's group, more of it.
+TEST(RobustnessEpisodes, FacingAwayPutsTheWayPointStraightBehind) {
+  EvaluationConfig c = config();
+  const std::vector<EvaluationEpisode> behind = facing_away_episodes(c, 6, 40, 7);
+  ASSERT_EQ(behind.size(), 40u);
+  for (const EvaluationEpisode& e : behind) {
+    EXPECT_EQ(e.group, "facing_away");
+    EXPECT_EQ(e.start.position_ned_m, c.task.start_position_ned_m);
+    EXPECT_TRUE(inside_region(c.task, e.goal_ned_m));
+    EXPECT_EQ(e.start.euler_rpy_rad[0], 0.0);
+    EXPECT_EQ(e.start.euler_rpy_rad[1], 0.0);
+    EXPECT_TRUE(e.start.velocity_body_mps.isZero());
+    const double yaw = e.start.euler_rpy_rad[2];
+    EXPECT_LE(std::abs(yaw), kPi);
+    // The horizontal way-point in the body frame: behind (x < 0), nothing to either side.
+    const Eigen::Vector3d to_goal = e.goal_ned_m - e.start.position_ned_m;
+    const double ahead_m = std::cos(yaw) * to_goal[0] + std::sin(yaw) * to_goal[1];
+    const double starboard_m = -std::sin(yaw) * to_goal[0] + std::cos(yaw) * to_goal[1];
+    EXPECT_LT(ahead_m, 0.0);
+    EXPECT_NEAR(starboard_m, 0.0, 1e-9);
+  }
+  c.robustness_facing_away = true;
+  const auto suite = of_group(robustness_episodes(c, 6, 5, 7), "facing_away");
+  ASSERT_EQ(suite.size(), 5u);
+  for (std::size_t i = 0; i < suite.size(); ++i) EXPECT_TRUE(same_draw(suite[i], behind[i])) << i;
+  EXPECT_THROW(facing_away_episodes(c, 6, -1, 7), std::invalid_argument);
+}
+
 TEST(RobustnessEpisodes, ReproducibleAndEachEpisodeItsOwnStream) {
   const EvaluationConfig c = config();
   const std::vector<EvaluationEpisode> a = robustness_episodes(c, 6, 5, 7);

@@ -21,6 +21,7 @@
 #include "launcher/training.hpp"
 #include "roles_fixture.hpp"
 #include "run_files.hpp"
+#include "tuning/candidate_selection.hpp"
 
 namespace auvrl::launcher {
 namespace {
@@ -257,9 +258,32 @@ TEST(RefinetuneTest, AnObjectiveTableThatCannotBeWrittenLosesNothing) {
   EXPECT_TRUE(fs::exists(tmp / "stage" / "finetune.csv"));
 }
 
+// An asynchronous run starts a further candidate only when, at the pace of those done, it ends
+// within finetune.candidates_within_s of training; a reproducible run, or no limit, runs them all.
+TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
+  tuning::FinetuneConfig config;
+  config.candidates = 3;
+  config.candidates_within_s = 58;
+  // 30 s of training, one search of 16 s: the next would end at 46 s.
+  EXPECT_FALSE(no_further_candidate(config, false, 30, 16, 1));
+  // 47 s, one search of 17 s: 64 s.
+  const auto why = no_further_candidate(config, false, 47, 17, 1);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("1 of 3 candidates"), std::string::npos) << *why;
+  EXPECT_NE(why->find("finetune.candidates_within_s (58 s)"), std::string::npos) << *why;
+  // The pace is the mean of the searches done: two in 30 s, 40 s so far, the third at 55 s.
+  EXPECT_FALSE(no_further_candidate(config, false, 40, 30, 2));
+  EXPECT_TRUE(no_further_candidate(config, false, 44, 30, 2));
+  // All done: nothing to skip. Reproducible, or no limit: never skipped.
+  EXPECT_FALSE(no_further_candidate(config, false, 100, 50, 3));
+  EXPECT_FALSE(no_further_candidate(config, true, 47, 17, 1));
+  config.candidates_within_s = 0;
+  EXPECT_FALSE(no_further_candidate(config, false, 470, 170, 1));
+}
+
 // With candidates, each search keeps its own progress file, the seeds follow the run's (the
-// one its command line gave), and the one passing the most robustness groups at the selection
-// seed is kept (two iterations each: the choice, not the search, is under test).
+// one its command line gave), and the one passing the most criteria at the selection seed
+// (robustness groups, way-points straight behind) is kept (two iterations each: the choice, not the search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   const TrainOptions options = fast_run_directory(tmp, "run", 4);
@@ -279,8 +303,13 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   ASSERT_EQ(rows[0].count("groups_passing"), 1u);
   EXPECT_EQ(rows[0].at("seed"), "4");
   EXPECT_EQ(rows[1].at("seed"), "5");
-  const std::size_t chosen =
-      std::stoi(rows[1].at("groups_passing")) > std::stoi(rows[0].at("groups_passing")) ? 1 : 0;
+  std::vector<tuning::CandidateScore> scores;
+  for (const auto& row : rows) {
+    scores.push_back({std::stoi(row.at("groups_passing")), std::stoi(row.at("behind_late")),
+                      std::stoi(row.at("behind_episodes"))});
+    EXPECT_EQ(row.at("behind_episodes"), std::to_string(tuning::kBehindEpisodes));
+  }
+  const std::size_t chosen = tuning::choose_candidate(scores);
   EXPECT_EQ(rows[chosen].at("chosen"), "1");
   EXPECT_EQ(rows[1 - chosen].at("chosen"), "0");
   EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen + 1)), std::string::npos)

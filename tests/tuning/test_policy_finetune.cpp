@@ -679,6 +679,8 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.pid_lead_s = std::numeric_limits<double>::infinity(); },
         +[](FinetuneConfig& f) { f.iterations = -1; }, +[](FinetuneConfig& f) { f.candidates = 0; },
         +[](FinetuneConfig& f) { f.candidates = 65; },
+        +[](FinetuneConfig& f) { f.candidates_within_s = -1; },
+        +[](FinetuneConfig& f) { f.candidates_within_s = std::nan(""); },
         +[](FinetuneConfig& f) { f.selection_seed = 1; }}) {
     FinetuneConfig f;
     bad(f);
