@@ -26,7 +26,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     out << "auvrl train: no policy was written; nothing to fine-tune or evaluate\n";
     return 1;
   }
-  const std::string policy_path = finetune_if_configured(ctx, *selected, out, false, training_start);
+  const std::string policy_path =
+      finetune_if_configured(ctx, *selected, out, false, training_start);
   sign_policies(ctx.run_dir, key, out);
   if (!options.evaluate) return 0;
   const EvaluationResult evaluation = evaluate_stage(ctx, policy_path, out);

@@ -221,20 +221,22 @@ double seconds_since(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-/// Runs every candidate's search and returns the one to keep: with one, it; with more, the one
-/// whose kept weights (or the start, where a search kept none) pass the most criteria at the
-/// selection seed (tuning::choose_candidate; candidates.csv has each). A search that fails after the first is
-/// said and the choice made among those done; Ctrl-C ends the searches after the one under way.
-CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
-                                  const eval::ValidationScore& before, std::ostream& out) {
-  if (in.config.candidates == 1) return search_candidate(in, start, before, 0, out);
+/// The candidates' searches, one after another, until all are done, Ctrl-C, a search that fails
+/// after the first (said; the choice is made among those done) or no_further_candidate.
+std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in,
+                                                    const nn::Mlp& start,
+                                                    const eval::ValidationScore& before,
+                                                    std::ostream& out) {
   const auto stage_start = std::chrono::steady_clock::now();
-  const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
   std::vector<CandidateSearch> searches;
-  std::vector<tuning::CandidateScore> scores;
-  std::vector<CandidatesRow> rows;
   for (int index = 0; index < in.config.candidates; ++index) {
     if (index > 0 && signals::stop_requested()) break;
+    if (const auto why =
+            no_further_candidate(in.config, in.reproducible, seconds_since(in.training_start),
+                                 seconds_since(stage_start), index)) {
+      out << "auvrl train: fine-tuning: " << *why << "\n";
+      break;
+    }
     try {
       searches.push_back(search_candidate(in, start, before, index, out));
     } catch (const std::exception& e) {
@@ -243,23 +245,33 @@ CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& s
           << "; choosing among the first " << searches.size() << "\n";
       break;
     }
-    const CandidateSearch& c = searches.back();
+  }
+  return searches;
+}
+
+/// Runs the candidates' searches and returns the one to keep: with one searched, it; with more,
+/// the one whose kept weights (or the start, where a search kept none) pass the most criteria at
+/// the selection seed (tuning::choose_candidate; candidates.csv has each), scored after the
+/// searches so that a run that searches one spends nothing on the choice.
+CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
+                                  const eval::ValidationScore& before, std::ostream& out) {
+  if (in.config.candidates == 1) return search_candidate(in, start, before, 0, out);
+  std::vector<CandidateSearch> searches = run_candidate_searches(in, start, before, out);
+  if (searches.size() == 1) return std::move(searches.front());  // nothing to choose between
+  const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
+  std::vector<tuning::CandidateScore> scores;
+  std::vector<CandidatesRow> rows;
+  for (const CandidateSearch& c : searches) {
     const tuning::CandidateScore score = selector.score(c.best.net ? *c.best.net : start);
     scores.push_back(score);
-    rows.push_back({index + 1, c.seed, c.best.iteration, c.result.best_objective,
-                    score.groups_passing, selector.groups(), score.behind_late,
-                    score.behind_episodes, false});
+    const int number = static_cast<int>(rows.size()) + 1;
+    rows.push_back({number, c.seed, c.best.iteration, c.result.best_objective, score.groups_passing,
+                    selector.groups(), score.behind_late, score.behind_episodes, false});
     out << fmt::format(
         "auvrl train: fine-tuning candidate {}/{} (seed {}): objective {:.3f} s, {} of {} "
         "robustness groups at seed {}, late on {} of {} way-points straight behind\n",
-        index + 1, in.config.candidates, c.seed, c.result.best_objective, score.groups_passing,
+        number, in.config.candidates, c.seed, c.result.best_objective, score.groups_passing,
         selector.groups(), in.config.selection_seed, score.behind_late, score.behind_episodes);
-    const double training_s = seconds_since(in.training_start);
-    if (const auto why = no_further_candidate(in.config, in.reproducible, training_s,
-                                              seconds_since(stage_start), index + 1)) {
-      out << "auvrl train: fine-tuning: " << *why << "\n";
-      break;
-    }
   }
   const std::size_t chosen = tuning::choose_candidate(scores);
   rows[chosen].chosen = true;
@@ -323,7 +335,7 @@ void record_finetune_start(const std::string& run_dir, const std::string& start_
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done) {
-  if (done >= config.candidates || reproducible || !(config.candidates_within_s > 0)) {
+  if (done < 1 || done >= config.candidates || reproducible || !(config.candidates_within_s > 0)) {
     return std::nullopt;
   }
   const double next_end_s = training_s + searches_s / done;

@@ -70,8 +70,8 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 /// Why the fine-tuning starts no further candidate after `done` searches, if so: an
 /// asynchronous run whose next search, at the mean pace of the searches so far (searches_s for
 /// the `done` of them), would end past config.candidates_within_s (when > 0) of training
-/// (training_s so far). Nothing when all are done (the loop ends anyway) or in a reproducible
-/// run, whose result must not depend on the machine's speed.
+/// (training_s so far). Nothing before the first search, when all are done (the loop ends
+/// anyway) or in a reproducible run, whose result must not depend on the machine's speed.
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done);

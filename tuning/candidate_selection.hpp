@@ -36,9 +36,7 @@ struct CandidateScore {
   int behind_late = 0;      ///< way-points straight behind reached late (kBehindLateMarginS)
   int behind_episodes = 0;  ///< of these
   /// At most kBehindLateFractionMax of the way-points straight behind late.
-  bool behind_passes() const {
-    return behind_late <= kBehindLateFractionMax * behind_episodes;
-  }
+  bool behind_passes() const { return behind_late <= kBehindLateFractionMax * behind_episodes; }
   /// The groups passing, plus one when the behind criterion passes.
   int criteria_passing() const { return groups_passing + (behind_passes() ? 1 : 0); }
 };

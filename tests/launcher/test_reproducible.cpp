@@ -32,12 +32,14 @@ bool has(const std::vector<std::string>& argv, const std::vector<std::string>& r
   return std::search(argv.begin(), argv.end(), run.begin(), run.end()) != argv.end();
 }
 
-/// A copy of the fast preset with `run_lines` added to its run: section and `learner_lines`
-/// to its learner: section (each line indented, ending in "\n").
+/// A copy of the fast preset without its budget in updates (learner.max_updates), with
+/// `run_lines` added to its run: section and `learner_lines` to its learner: section (each line
+/// indented, ending in "\n").
 std::string preset_with(const fs::path& dir, const std::string& run_lines,
                         const std::string& learner_lines = "") {
   return test_support::write_preset_copy(AUVRL_CONFIG_DIR, "fast", (dir / "run.yaml").string(),
                                          [&](std::string& line) {
+                                           if (line.rfind("  max_updates:", 0) == 0) line.clear();
                                            if (line == "run:") line += "\n" + run_lines;
                                            if (line == "learner:") line += "\n" + learner_lines;
                                          });
@@ -59,7 +61,8 @@ TEST(ReproducibleConfigTest, TheRunKeysDefaultsAndRanges) {
   EXPECT_FALSE(fast.run.reproducible);
   EXPECT_EQ(fast.run.round_weights_every_steps, 100);
   EXPECT_EQ(fast.run.best_eval_every_updates, 40000);
-  EXPECT_EQ(fast.learner_max_updates, 0);
+  EXPECT_EQ(fast.learner_max_updates, 300000);  // the TD3 phase's end, or run.max_train_s
+  EXPECT_EQ(read_run_config(preset_with(dir, "")).learner_max_updates, 0);
 
   const RunConfig set = read_run_config(preset_with(
       dir,
@@ -81,7 +84,7 @@ class ReproducibleRunTest : public ::testing::Test {
  protected:
   void SetUp() override {
     tmp = test_support::make_temp_dir("auvrl_repro_run_");
-    options.config_path = std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml";
+    options.config_path = preset_with(tmp, "");  // no budget in updates
     options.run_dir = (tmp / "run").string();
   }
   fs::path tmp;
@@ -104,7 +107,7 @@ TEST_F(ReproducibleRunTest, ANewRunWithoutABudgetInUpdatesIsRefusedBeforeItsDire
 }
 
 TEST_F(ReproducibleRunTest, TheBudgetIsCheckedForTrainingOnly) {
-  prepare_run_directory(options);  // an asynchronous run (the fast preset)
+  prepare_run_directory(options);  // an asynchronous run (the fast preset, no budget in updates)
   options.resume = true;
   EXPECT_FALSE(load_run_context(options).rc.run.reproducible);
   options.reproducible = true;  // --resume RUN --reproducible

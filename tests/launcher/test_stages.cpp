@@ -274,7 +274,8 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
   // The pace is the mean of the searches done: two in 30 s, 40 s so far, the third at 55 s.
   EXPECT_FALSE(no_further_candidate(config, false, 40, 30, 2));
   EXPECT_TRUE(no_further_candidate(config, false, 44, 30, 2));
-  // All done: nothing to skip. Reproducible, or no limit: never skipped.
+  // The first always runs; all done: nothing to skip. Reproducible, or no limit: never skipped.
+  EXPECT_FALSE(no_further_candidate(config, false, 100, 0, 0));
   EXPECT_FALSE(no_further_candidate(config, false, 100, 50, 3));
   EXPECT_FALSE(no_further_candidate(config, true, 47, 17, 1));
   config.candidates_within_s = 0;
@@ -283,7 +284,8 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
 
 // With candidates, each search keeps its own progress file, the seeds follow the run's (the
 // one its command line gave), and the one passing the most criteria at the selection seed
-// (robustness groups, way-points straight behind) is kept (two iterations each: the choice, not the search, is under test).
+// (robustness groups, way-points straight behind) is kept (two iterations each: the choice, not the
+// search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   const TrainOptions options = fast_run_directory(tmp, "run", 4);

@@ -161,8 +161,8 @@ TEST(TelemetryTest, ObjectiveTermsARowPerControllerEveryPriceInSeconds) {
 
 TEST(TelemetryTest, CandidatesARowPerSearchTheChosenMarked) {
   const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
-  write_candidates((dir / "candidates.csv").string(),
-                   {{1, 3, 80, 18.75, 21, 25, 15, 100, false}, {2, 4, 0, 19.5, 25, 25, 4, 100, true}});
+  write_candidates((dir / "candidates.csv").string(), {{1, 3, 80, 18.75, 21, 25, 15, 100, false},
+                                                       {2, 4, 0, 19.5, 25, 25, 4, 100, true}});
   EXPECT_EQ(slurp(dir / "candidates.csv"),
             "candidate,seed,kept_iteration,objective_s,groups_passing,groups,behind_late,"
             "behind_episodes,chosen\n"
