@@ -164,6 +164,25 @@ EvaluationEpisode draw_episode(const EvaluationConfig& config, int num_thrusters
   return e;
 }
 
+/// The first `count` episodes of group g drawn at seed (each from its own stream).
+void draw_group(const EvaluationConfig& config, int num_thrusters, const RobustnessGroup& g,
+                int count, std::uint64_t seed, std::vector<EvaluationEpisode>& episodes) {
+  const std::uint64_t group_seed = splitmix64(seed ^ fnv1a64(g.name));
+  for (int i = 0; i < count; ++i) {
+    episodes.push_back(draw_episode(config, num_thrusters, g, i, group_seed));
+  }
+}
+
+/// The group facing_away (robustness_groups with with_facing_away).
+RobustnessGroup facing_away_group() {
+  GroupDraw away;
+  away.facing_away = true;
+  return group("facing_away",
+               "at rest at the start position, the way-point in the region straight behind (not "
+               "one of the bar's groups)",
+               away);
+}
+
 double mean_or_nan(double sum, int count) {
   return count > 0 ? sum / count : std::numeric_limits<double>::quiet_NaN();
 }
@@ -251,14 +270,7 @@ std::vector<RobustnessGroup> robustness_groups(int num_thrusters,
   v = {};
   v.extra_buoyancy_n = 2.0 * kGravityMps2;
   groups.push_back(model_group("buoyancy_+2kg", "2 kg of extra buoyancy (19.62 N)", v));
-  if (with_facing_away) {
-    GroupDraw away;
-    away.facing_away = true;
-    groups.push_back(group("facing_away",
-                           "at rest at the start position, the way-point in the region straight "
-                           "behind (not one of the bar's groups)",
-                           away));
-  }
+  if (with_facing_away) groups.push_back(facing_away_group());
   return groups;
 }
 
@@ -278,10 +290,7 @@ std::vector<EvaluationEpisode> robustness_episodes(const EvaluationConfig& confi
   std::vector<EvaluationEpisode> episodes;
   for (const RobustnessGroup& g :
        robustness_groups(num_thrusters, {}, config.robustness_facing_away)) {
-    const std::uint64_t group_seed = splitmix64(seed ^ fnv1a64(g.name));
-    for (int i = 0; i < episodes_per_group; ++i) {
-      episodes.push_back(draw_episode(config, num_thrusters, g, i, group_seed));
-    }
+    draw_group(config, num_thrusters, g, episodes_per_group, seed, episodes);
   }
   return episodes;
 }
@@ -510,12 +519,8 @@ std::vector<EvaluationEpisode> facing_away_episodes(const EvaluationConfig& conf
                                                     int num_thrusters, int count,
                                                     std::uint64_t seed) {
   if (count < 0) throw std::invalid_argument("facing_away_episodes: count must be >= 0");
-  const RobustnessGroup away = robustness_groups(num_thrusters, {}, true).back();
-  const std::uint64_t group_seed = splitmix64(seed ^ fnv1a64(away.name));
   std::vector<EvaluationEpisode> episodes;
-  for (int i = 0; i < count; ++i) {
-    episodes.push_back(draw_episode(config, num_thrusters, away, i, group_seed));
-  }
+  draw_group(config, num_thrusters, facing_away_group(), count, seed, episodes);
   return episodes;
 }
 

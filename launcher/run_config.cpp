@@ -105,7 +105,7 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "most criteria at selection_seed (the robustness groups, way-points straight behind)");
   t.field("candidates_within_s", &C::candidates_within_s, "s, 0: no limit",
           "an asynchronous run starts a further candidate only if it would end within this "
-          "many seconds of the fine-tuning's start, at the pace of those before");
+          "many seconds of the training's start, at the pace of those before");
   t.field("selection_seed", &C::selection_seed, "not 1",
           "the robustness suite's draw that chooses among the candidates, and on which the "
           "trained policies' flips are counted (select)");

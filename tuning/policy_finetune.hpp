@@ -125,9 +125,9 @@ struct FinetuneConfig {
   /// and the way-points straight behind (tuning::choose_candidate). 1: one search, no choice.
   int candidates = 1;
   /// An asynchronous run's fine-tuning starts a further candidate only when, at the pace of
-  /// those before, it would end within this many seconds of the stage's start (s; 0: no limit),
-  /// so that a slower machine keeps the training's minute with fewer candidates. A reproducible
-  /// run searches them all.
+  /// those before, it would end within this many seconds of the training's start (its TD3 phase,
+  /// or `auvrl finetune`'s start; s; 0: no limit), so that a slower machine keeps the training's
+  /// minute with fewer candidates. A reproducible run searches them all.
   double candidates_within_s = 0.0;
   /// The robustness suite's draw that chooses among the candidates, and on which the pipeline's
   /// select stage counts the trained policies' flips: a validation draw of its own, never the
