@@ -171,6 +171,11 @@ fs::path candidate_path(const FinetuneStageInput& in, const std::string& stem,
   return fs::path(in.run_dir) / (stem + suffix + extension);
 }
 
+/// Seconds from `since` to now.
+double seconds_since(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
 /// Runs candidate `index`'s search from `start` (validated as `before`), its progress to its
 /// finetune.csv, validating every validate_every iterations and at the end.
 CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& start,
@@ -187,8 +192,16 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
   const std::string label = in.config.candidates == 1
                                 ? std::string()
                                 : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
+  bool past_limit = false;  // the search ends after this iteration (search_past_limit)
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
-    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations) {
+    if (const auto why = search_past_limit(in.config, in.reproducible,
+                                           seconds_since(in.training_start), it.elapsed_s,
+                                           it.iteration)) {
+      out << "auvrl train: fine-tuning" << label << ": " << *why << "\n";
+      past_limit = true;
+    }
+    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations &&
+        !past_limit) {
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
       return;
     }
@@ -207,18 +220,13 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
   };
   tuning::FinetuneResult result =
       tuning::finetune_policy(in.model, in.task, start, in.config, seed, progress,
-                              [] { return signals::stop_requested(); });
+                              [&] { return past_limit || signals::stop_requested(); });
   try {
     csv.writer().flush();
   } catch (const std::exception&) {
     out << "auvrl train: could not write " << csv.writer().path() << "\n";
   }
   return CandidateSearch{seed, std::move(best), std::move(result)};
-}
-
-/// Seconds from `since` to now.
-double seconds_since(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
 /// The candidates' searches, one after another, until all are done, Ctrl-C, a search that fails
@@ -335,15 +343,32 @@ void record_finetune_start(const std::string& run_dir, const std::string& start_
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done) {
-  if (done < 1 || done >= config.candidates || reproducible || !(config.candidates_within_s > 0)) {
+  if (done < 1 || done >= config.candidates || reproducible) return std::nullopt;
+  const double next_end_s = training_s + searches_s / done;
+  for (const auto& [limit_s, key] : {std::pair{config.candidates_within_s, "candidates_within_s"},
+                                     std::pair{config.search_within_s, "search_within_s"}}) {
+    if (limit_s > 0 && next_end_s > limit_s) {
+      return fmt::format(
+          "{} of {} candidates searched after {:.1f} s of training; another would end at about "
+          "{:.1f} s, past finetune.{} ({:g} s): choosing among these",
+          done, config.candidates, training_s, next_end_s, key, limit_s);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> search_past_limit(const tuning::FinetuneConfig& config,
+                                             bool reproducible, double training_s,
+                                             double search_s, int done) {
+  if (reproducible || !(config.search_within_s > 0) || done < 1 || done >= config.iterations) {
     return std::nullopt;
   }
-  const double next_end_s = training_s + searches_s / done;
-  if (next_end_s <= config.candidates_within_s) return std::nullopt;
+  const double next_end_s = training_s + search_s / done;
+  if (next_end_s <= config.search_within_s) return std::nullopt;
   return fmt::format(
-      "{} of {} candidates searched after {:.1f} s of training; another would end at about "
-      "{:.1f} s, past finetune.candidates_within_s ({:g} s): choosing among these",
-      done, config.candidates, training_s, next_end_s, config.candidates_within_s);
+      "ended after iteration {} of {} at {:.1f} s of training; the next would end at about "
+      "{:.1f} s, past finetune.search_within_s ({:g} s)",
+      done, config.iterations, training_s, next_end_s, config.search_within_s);
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {

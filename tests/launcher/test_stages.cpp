@@ -280,6 +280,75 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
   EXPECT_FALSE(no_further_candidate(config, true, 47, 17, 1));
   config.candidates_within_s = 0;
   EXPECT_FALSE(no_further_candidate(config, false, 470, 170, 1));
+  // Nor one that would end past the searches' own limit.
+  config.search_within_s = 57;
+  EXPECT_FALSE(no_further_candidate(config, false, 30, 16, 1));
+  const auto past_search_limit = no_further_candidate(config, false, 42, 16, 1);
+  ASSERT_TRUE(past_search_limit);
+  EXPECT_NE(past_search_limit->find("finetune.search_within_s (57 s)"), std::string::npos)
+      << *past_search_limit;
+  EXPECT_FALSE(no_further_candidate(config, true, 42, 16, 1));
+}
+
+// An asynchronous run's search ends once its next iteration, at the mean pace of those done,
+// would end past finetune.search_within_s of training; never a reproducible run's, nor after
+// its last iteration, nor without a limit.
+TEST(SearchWithinTest, ASearchEndsWhenItsNextIterationWouldEndPastTheLimit) {
+  tuning::FinetuneConfig config;
+  config.iterations = 72;
+  config.search_within_s = 57;
+  // 50 s of training, 40 iterations in 10 s: the next would end at 50.25 s.
+  EXPECT_FALSE(search_past_limit(config, false, 50, 10, 40));
+  // 56.9 s, 60 iterations in 15 s: 57.15 s.
+  const auto why = search_past_limit(config, false, 56.9, 15, 60);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("ended after iteration 60 of 72"), std::string::npos) << *why;
+  EXPECT_NE(why->find("finetune.search_within_s (57 s)"), std::string::npos) << *why;
+  EXPECT_FALSE(search_past_limit(config, true, 56.9, 15, 60));
+  EXPECT_FALSE(search_past_limit(config, false, 100, 15, 72));
+  EXPECT_FALSE(search_past_limit(config, false, 100, 15, 0));
+  config.search_within_s = 0;
+  EXPECT_FALSE(search_past_limit(config, false, 560, 150, 60));
+}
+
+// A search cut short by finetune.search_within_s validates the iteration it ends at and keeps
+// the best validated weights, as at its last iteration.
+TEST(RefinetuneTest, ASearchPastItsTimeLimitEndsValidatedAndKeepsItsBest) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  const TrainOptions options = fast_run_directory(tmp, "run", 4);
+  const std::string policy = (tmp / "run" / "policy.nn").string();
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
+  std::ifstream preset(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
+  std::ostringstream text;
+  text << preset.rdbuf();
+  std::string yaml = text.str();
+  const std::size_t section = yaml.find("\nfinetune:\n");
+  ASSERT_NE(section, std::string::npos);
+  // Already past the limit after the first iteration (the preset's own key, set again).
+  yaml.insert(section + 11, "  search_within_s: 0.001\n");
+  const std::size_t own = yaml.find("  search_within_s:", section + 40);
+  if (own != std::string::npos) yaml.erase(own, yaml.find('\n', own) - own + 1);
+  const fs::path config = tmp / "limited.yaml";
+  std::ofstream(config) << yaml;
+  RefinetuneOptions o;
+  o.run_dir = options.run_dir;
+  o.config_path = config.string();
+  o.out_dir = (tmp / "again").string();
+  o.iterations = 5;
+  o.candidates = 2;
+  std::ostringstream out;
+  ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  EXPECT_NE(out.str().find("ended after iteration 1 of 5"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("1 of 2 candidates searched"), std::string::npos) << out.str();
+  const auto rows = test_support::read_csv(tmp / "again" / "finetune.csv");
+  ASSERT_EQ(rows.size(), 1u) << out.str();
+  EXPECT_EQ(rows[0].at("iteration"), "1");
+  EXPECT_FALSE(rows[0].at("validation_reached").empty());
+  EXPECT_FALSE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
+  std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
+  std::string evaluated;
+  std::getline(selected, evaluated);
+  EXPECT_TRUE(evaluated == policy || evaluated == o.out_dir + "/policy_finetuned.nn") << evaluated;
 }
 
 // With candidates, each search keeps its own progress file, the seeds follow the run's (the
