@@ -194,14 +194,13 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
                                 : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
   bool past_limit = false;  // the search ends after this iteration (search_past_limit)
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
-    if (const auto why = search_past_limit(in.config, in.reproducible,
-                                           seconds_since(in.training_start), it.elapsed_s,
-                                           it.iteration)) {
+    if (const auto why =
+            search_past_limit(in.config, in.reproducible, seconds_since(in.training_start),
+                              it.elapsed_s, it.iteration)) {
       out << "auvrl train: fine-tuning" << label << ": " << *why << "\n";
       past_limit = true;
     }
-    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations &&
-        !past_limit) {
+    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations && !past_limit) {
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
       return;
     }
@@ -358,8 +357,8 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
 }
 
 std::optional<std::string> search_past_limit(const tuning::FinetuneConfig& config,
-                                             bool reproducible, double training_s,
-                                             double search_s, int done) {
+                                             bool reproducible, double training_s, double search_s,
+                                             int done) {
   if (reproducible || !(config.search_within_s > 0) || done < 1 || done >= config.iterations) {
     return std::nullopt;
   }

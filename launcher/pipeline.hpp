@@ -70,8 +70,9 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 /// Why the fine-tuning starts no further candidate after `done` searches, if so: an
 /// asynchronous run whose next search, at the mean pace of the searches so far (searches_s for
 /// the `done` of them), would end past config.candidates_within_s or config.search_within_s
-/// (each when > 0) of training (training_s so far). Nothing before the first search, when all are done (the loop ends
-/// anyway) or in a reproducible run, whose result must not depend on the machine's speed.
+/// (each when > 0) of training (training_s so far). Nothing before the first search, when all are
+/// done (the loop ends anyway) or in a reproducible run, whose result must not depend on the
+/// machine's speed.
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done);
@@ -81,8 +82,8 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
 /// config.search_within_s (when > 0) of training (training_s so far). Never in a reproducible
 /// run, nor after the last iteration (the search ends there anyway).
 std::optional<std::string> search_past_limit(const tuning::FinetuneConfig& config,
-                                             bool reproducible, double training_s,
-                                             double search_s, int done);
+                                             bool reproducible, double training_s, double search_s,
+                                             int done);
 
 /// The file in a run directory that names the policy its fine-tuning started from: relative to
 /// the run directory when inside it, so that the run can be moved.
