@@ -177,9 +177,11 @@ double seconds_since(std::chrono::steady_clock::time_point since) {
 }
 
 /// Runs candidate `index`'s search from `start` (validated as `before`), its progress to its
-/// finetune.csv, validating every validate_every iterations and at the end.
+/// finetune.csv, validating every validate_every iterations and at the end, or where
+/// search_past_cap ends it (searches_start: the first search's start).
 CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& start,
                                  const eval::ValidationScore& before, int index,
+                                 std::chrono::steady_clock::time_point searches_start,
                                  std::ostream& out) {
   constexpr int validate_every = 10;
   const eval::Ranking ranking = finetune_ranking(in.config, in.max_hold_m);
@@ -192,15 +194,14 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
   const std::string label = in.config.candidates == 1
                                 ? std::string()
                                 : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
-  bool past_limit = false;  // the search ends after this iteration (search_past_limit)
+  bool past_cap = false;  // the search ends after this iteration (search_past_cap)
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
-    if (const auto why =
-            search_past_limit(in.config, in.reproducible, seconds_since(in.training_start),
-                              it.elapsed_s, it.iteration)) {
+    if (const auto why = search_past_cap(in.config, in.reproducible, seconds_since(searches_start),
+                                         it.elapsed_s, it.iteration)) {
       out << "auvrl train: fine-tuning" << label << ": " << *why << "\n";
-      past_limit = true;
+      past_cap = true;
     }
-    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations && !past_limit) {
+    if (it.iteration % validate_every != 0 && it.iteration != in.config.iterations && !past_cap) {
       csv.add(it.iteration, it.objective, it.elapsed_s, nullptr);
       return;
     }
@@ -219,7 +220,7 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
   };
   tuning::FinetuneResult result =
       tuning::finetune_policy(in.model, in.task, start, in.config, seed, progress,
-                              [&] { return past_limit || signals::stop_requested(); });
+                              [&] { return past_cap || signals::stop_requested(); });
   try {
     csv.writer().flush();
   } catch (const std::exception&) {
@@ -234,18 +235,18 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
                                                     const nn::Mlp& start,
                                                     const eval::ValidationScore& before,
                                                     std::ostream& out) {
-  const auto stage_start = std::chrono::steady_clock::now();
+  const auto searches_start = std::chrono::steady_clock::now();
   std::vector<CandidateSearch> searches;
   for (int index = 0; index < in.config.candidates; ++index) {
     if (index > 0 && signals::stop_requested()) break;
     if (const auto why =
             no_further_candidate(in.config, in.reproducible, seconds_since(in.training_start),
-                                 seconds_since(stage_start), index)) {
+                                 seconds_since(searches_start), index)) {
       out << "auvrl train: fine-tuning: " << *why << "\n";
       break;
     }
     try {
-      searches.push_back(search_candidate(in, start, before, index, out));
+      searches.push_back(search_candidate(in, start, before, index, searches_start, out));
     } catch (const std::exception& e) {
       if (searches.empty()) throw;
       out << "auvrl train: fine-tuning candidate " << index + 1 << " failed: " << e.what()
@@ -262,7 +263,9 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
 /// searches so that a run that searches one spends nothing on the choice.
 CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
                                   const eval::ValidationScore& before, std::ostream& out) {
-  if (in.config.candidates == 1) return search_candidate(in, start, before, 0, out);
+  if (in.config.candidates == 1) {
+    return search_candidate(in, start, before, 0, std::chrono::steady_clock::now(), out);
+  }
   std::vector<CandidateSearch> searches = run_candidate_searches(in, start, before, out);
   if (searches.size() == 1) return std::move(searches.front());  // nothing to choose between
   const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
@@ -343,31 +346,36 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done) {
   if (done < 1 || done >= config.candidates || reproducible) return std::nullopt;
-  const double next_end_s = training_s + searches_s / done;
-  for (const auto& [limit_s, key] : {std::pair{config.candidates_within_s, "candidates_within_s"},
-                                     std::pair{config.search_within_s, "search_within_s"}}) {
-    if (limit_s > 0 && next_end_s > limit_s) {
-      return fmt::format(
-          "{} of {} candidates searched after {:.1f} s of training; another would end at about "
-          "{:.1f} s, past finetune.{} ({:g} s): choosing among these",
-          done, config.candidates, training_s, next_end_s, key, limit_s);
-    }
+  const double pace_s = searches_s / done;
+  const std::string searched =
+      fmt::format("{} of {} candidates searched after {:.1f} s of training", done,
+                  config.candidates, training_s);
+  if (config.candidates_within_s > 0 && training_s + pace_s > config.candidates_within_s) {
+    return fmt::format(
+        "{}; another would end at about {:.1f} s, past finetune.candidates_within_s ({:g} s): "
+        "choosing among these",
+        searched, training_s + pace_s, config.candidates_within_s);
+  }
+  if (config.max_search_s > 0 && searches_s + pace_s > config.max_search_s) {
+    return fmt::format(
+        "{}; another would end at about {:.1f} s of searching, past finetune.max_search_s "
+        "({:g} s): choosing among these",
+        searched, searches_s + pace_s, config.max_search_s);
   }
   return std::nullopt;
 }
 
-std::optional<std::string> search_past_limit(const tuning::FinetuneConfig& config,
-                                             bool reproducible, double training_s, double search_s,
-                                             int done) {
-  if (reproducible || !(config.search_within_s > 0) || done < 1 || done >= config.iterations) {
+std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
+                                           double searches_s, double search_s, int done) {
+  if (reproducible || !(config.max_search_s > 0) || done < 1 || done >= config.iterations) {
     return std::nullopt;
   }
-  const double next_end_s = training_s + search_s / done;
-  if (next_end_s <= config.search_within_s) return std::nullopt;
+  const double next_end_s = searches_s + search_s / done;
+  if (next_end_s <= config.max_search_s) return std::nullopt;
   return fmt::format(
-      "ended after iteration {} of {} at {:.1f} s of training; the next would end at about "
-      "{:.1f} s, past finetune.search_within_s ({:g} s)",
-      done, config.iterations, training_s, next_end_s, config.search_within_s);
+      "ended after iteration {} of {} at {:.1f} s of searching; the next would end at about "
+      "{:.1f} s, past finetune.max_search_s ({:g} s)",
+      done, config.iterations, searches_s, next_end_s, config.max_search_s);
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {

@@ -69,21 +69,21 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
 
 /// Why the fine-tuning starts no further candidate after `done` searches, if so: an
 /// asynchronous run whose next search, at the mean pace of the searches so far (searches_s for
-/// the `done` of them), would end past config.candidates_within_s or config.search_within_s
-/// (each when > 0) of training (training_s so far). Nothing before the first search, when all are
-/// done (the loop ends anyway) or in a reproducible run, whose result must not depend on the
-/// machine's speed.
+/// the `done` of them), would end past config.candidates_within_s (when > 0) of training
+/// (training_s so far) or past config.max_search_s (when > 0) of searching. Nothing before the
+/// first search, when all are done (the loop ends anyway) or in a reproducible run, whose result
+/// must not depend on the machine's speed.
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done);
 
 /// Why an asynchronous run's search ends after `done` iterations of its config.iterations, if
 /// so: at the mean pace of those (search_s for them), the next would end past
-/// config.search_within_s (when > 0) of training (training_s so far). Never in a reproducible
-/// run, nor after the last iteration (the search ends there anyway).
-std::optional<std::string> search_past_limit(const tuning::FinetuneConfig& config,
-                                             bool reproducible, double training_s, double search_s,
-                                             int done);
+/// config.max_search_s (when > 0) of searching (searches_s so far, from the first search's
+/// start). Never in a reproducible run, nor after the last iteration (the search ends there
+/// anyway).
+std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
+                                           double searches_s, double search_s, int done);
 
 /// The file in a run directory that names the policy its fine-tuning started from: relative to
 /// the run directory when inside it, so that the run can be moved.
@@ -103,8 +103,8 @@ std::optional<std::string> finetune_start(const std::string& run_dir);
 /// Runs the fine-tuning stage when configured (keep_iterates: FinetuneStageInput's), first
 /// recording policy_path in RUN/finetune_start.txt (a record: when it cannot be written the
 /// stage says so and goes on); on a failure keeps policy_path. Returns the path of the policy
-/// to evaluate. training_start: when the training began (finetune.candidates_within_s and
-/// search_within_s count from it).
+/// to evaluate. training_start: when the training began (finetune.candidates_within_s counts
+/// from it).
 std::string finetune_if_configured(
     const RunContext& ctx, const std::string& policy_path, std::ostream& out,
     bool keep_iterates = false,

@@ -109,8 +109,8 @@ void FinetuneConfig::validate() const {
   require(candidates >= 1 && candidates <= 64, "candidates must be in [1, 64]");
   require(std::isfinite(candidates_within_s) && candidates_within_s >= 0.0,
           "candidates_within_s must be >= 0 s (0: no limit)");
-  require(std::isfinite(search_within_s) && search_within_s >= 0.0,
-          "search_within_s must be >= 0 s (0: no limit)");
+  require(std::isfinite(max_search_s) && max_search_s >= 0.0,
+          "max_search_s must be >= 0 s (0: no cap)");
   require(selection_seed != eval::EvaluationConfig{}.seed,
           "selection_seed must not be " + std::to_string(eval::EvaluationConfig{}.seed) +
               ", the evaluation's own draw of the robustness suite");

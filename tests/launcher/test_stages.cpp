@@ -280,40 +280,43 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
   EXPECT_FALSE(no_further_candidate(config, true, 47, 17, 1));
   config.candidates_within_s = 0;
   EXPECT_FALSE(no_further_candidate(config, false, 470, 170, 1));
-  // Nor one that would end past the searches' own limit.
-  config.search_within_s = 57;
-  EXPECT_FALSE(no_further_candidate(config, false, 30, 16, 1));
-  const auto past_search_limit = no_further_candidate(config, false, 42, 16, 1);
-  ASSERT_TRUE(past_search_limit);
-  EXPECT_NE(past_search_limit->find("finetune.search_within_s (57 s)"), std::string::npos)
-      << *past_search_limit;
-  EXPECT_FALSE(no_further_candidate(config, true, 42, 16, 1));
+  // Nor one that would end past the searches' own cap, counted from the first one's start.
+  config.max_search_s = 20;
+  EXPECT_FALSE(no_further_candidate(config, false, 30, 9, 1));
+  const auto past_cap = no_further_candidate(config, false, 30, 11, 1);
+  ASSERT_TRUE(past_cap);
+  EXPECT_NE(past_cap->find("22.0 s of searching, past finetune.max_search_s (20 s)"),
+            std::string::npos)
+      << *past_cap;
+  EXPECT_FALSE(no_further_candidate(config, true, 30, 11, 1));
 }
 
 // An asynchronous run's search ends once its next iteration, at the mean pace of those done,
-// would end past finetune.search_within_s of training; never a reproducible run's, nor after
-// its last iteration, nor without a limit.
-TEST(SearchWithinTest, ASearchEndsWhenItsNextIterationWouldEndPastTheLimit) {
+// would end past finetune.max_search_s of searching; never a reproducible run's, nor after its
+// last iteration, nor without a cap.
+TEST(MaxSearchTest, ASearchEndsWhenItsNextIterationWouldEndPastTheCap) {
   tuning::FinetuneConfig config;
   config.iterations = 72;
-  config.search_within_s = 57;
-  // 50 s of training, 40 iterations in 10 s: the next would end at 50.25 s.
-  EXPECT_FALSE(search_past_limit(config, false, 50, 10, 40));
-  // 56.9 s, 60 iterations in 15 s: 57.15 s.
-  const auto why = search_past_limit(config, false, 56.9, 15, 60);
+  config.max_search_s = 20;
+  // 10 s of searching, 40 iterations in 10 s: the next would end at 10.25 s.
+  EXPECT_FALSE(search_past_cap(config, false, 10, 10, 40));
+  // The second search 4 s in, after 15 s of the first: 20 iterations in 4 s, the next at 19.2 s.
+  EXPECT_FALSE(search_past_cap(config, false, 19, 4, 20));
+  // 19.9 s, 60 iterations in 15 s: 20.15 s.
+  const auto why = search_past_cap(config, false, 19.9, 15, 60);
   ASSERT_TRUE(why);
   EXPECT_NE(why->find("ended after iteration 60 of 72"), std::string::npos) << *why;
-  EXPECT_NE(why->find("finetune.search_within_s (57 s)"), std::string::npos) << *why;
-  EXPECT_FALSE(search_past_limit(config, true, 56.9, 15, 60));
-  EXPECT_FALSE(search_past_limit(config, false, 100, 15, 72));
-  EXPECT_FALSE(search_past_limit(config, false, 100, 15, 0));
-  config.search_within_s = 0;
-  EXPECT_FALSE(search_past_limit(config, false, 560, 150, 60));
+  EXPECT_NE(why->find("finetune.max_search_s (20 s)"), std::string::npos) << *why;
+  EXPECT_FALSE(search_past_cap(config, true, 19.9, 15, 60));
+  EXPECT_FALSE(search_past_cap(config, false, 100, 15, 72));
+  EXPECT_FALSE(search_past_cap(config, false, 100, 15, 0));
+  config.max_search_s = 0;
+  EXPECT_FALSE(search_past_cap(config, false, 560, 150, 60));
 }
 
-// A search cut short by finetune.search_within_s validates the iteration it ends at and keeps
-// the best validated weights, as at its last iteration.
-TEST(RefinetuneTest, ASearchPastItsTimeLimitEndsValidatedAndKeepsItsBest) {
+// A search cut short by finetune.max_search_s validates the iteration it ends at and keeps the
+// best validated weights, as at its last iteration, and no further candidate starts.
+TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   const TrainOptions options = fast_run_directory(tmp, "run", 4);
   const std::string policy = (tmp / "run" / "policy.nn").string();
@@ -322,13 +325,11 @@ TEST(RefinetuneTest, ASearchPastItsTimeLimitEndsValidatedAndKeepsItsBest) {
   std::ostringstream text;
   text << preset.rdbuf();
   std::string yaml = text.str();
-  const std::size_t section = yaml.find("\nfinetune:\n");
-  ASSERT_NE(section, std::string::npos);
-  // Already past the limit after the first iteration (the preset's own key, set again).
-  yaml.insert(section + 11, "  search_within_s: 0.001\n");
-  const std::size_t own = yaml.find("  search_within_s:", section + 40);
-  if (own != std::string::npos) yaml.erase(own, yaml.find('\n', own) - own + 1);
-  const fs::path config = tmp / "limited.yaml";
+  // The preset's cap replaced by one that the first iteration already passes.
+  const std::size_t own = yaml.find("\n  max_search_s: ");
+  ASSERT_NE(own, std::string::npos);
+  yaml.replace(own, yaml.find('\n', own + 1) - own, "\n  max_search_s: 0.001");
+  const fs::path config = tmp / "capped.yaml";
   std::ofstream(config) << yaml;
   RefinetuneOptions o;
   o.run_dir = options.run_dir;
