@@ -263,9 +263,6 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
 /// searches so that a run that searches one spends nothing on the choice.
 CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
                                   const eval::ValidationScore& before, std::ostream& out) {
-  if (in.config.candidates == 1) {
-    return search_candidate(in, start, before, 0, std::chrono::steady_clock::now(), out);
-  }
   std::vector<CandidateSearch> searches = run_candidate_searches(in, start, before, out);
   if (searches.size() == 1) return std::move(searches.front());  // nothing to choose between
   const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
@@ -340,6 +337,12 @@ void record_finetune_start(const std::string& run_dir, const std::string& start_
   if (!file) out << "auvrl train: could not write " << path.string() << "\n";
 }
 
+/// Whether the next of `done` equal pieces of work (done_s for them) ends past limit_s (when > 0)
+/// on a clock now at elapsed_s: the projection both time limits of the fine-tuning make.
+bool next_ends_past(double limit_s, double elapsed_s, double done_s, int done) {
+  return limit_s > 0 && elapsed_s + done_s / done > limit_s;
+}
+
 }  // namespace
 
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
@@ -350,13 +353,13 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
   const std::string searched =
       fmt::format("{} of {} candidates searched after {:.1f} s of training", done,
                   config.candidates, training_s);
-  if (config.candidates_within_s > 0 && training_s + pace_s > config.candidates_within_s) {
+  if (next_ends_past(config.candidates_within_s, training_s, searches_s, done)) {
     return fmt::format(
         "{}; another would end at about {:.1f} s, past finetune.candidates_within_s ({:g} s): "
         "choosing among these",
         searched, training_s + pace_s, config.candidates_within_s);
   }
-  if (config.max_search_s > 0 && searches_s + pace_s > config.max_search_s) {
+  if (next_ends_past(config.max_search_s, searches_s, searches_s, done)) {
     return fmt::format(
         "{}; another would end at about {:.1f} s of searching, past finetune.max_search_s "
         "({:g} s): choosing among these",
@@ -367,15 +370,14 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
 
 std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
                                            double searches_s, double search_s, int done) {
-  if (reproducible || !(config.max_search_s > 0) || done < 1 || done >= config.iterations) {
+  if (reproducible || done < 1 || done >= config.iterations ||
+      !next_ends_past(config.max_search_s, searches_s, search_s, done)) {
     return std::nullopt;
   }
-  const double next_end_s = searches_s + search_s / done;
-  if (next_end_s <= config.max_search_s) return std::nullopt;
   return fmt::format(
       "ended after iteration {} of {} at {:.1f} s of searching; the next would end at about "
       "{:.1f} s, past finetune.max_search_s ({:g} s)",
-      done, config.iterations, searches_s, next_end_s, config.max_search_s);
+      done, config.iterations, searches_s, searches_s + search_s / done, config.max_search_s);
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {

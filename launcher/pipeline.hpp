@@ -47,7 +47,8 @@ struct FinetuneStageInput {
   /// candidate K's to iterates_candidateK/), for evaluating how the fine-tuning went beyond what
   /// it keeps.
   bool keep_iterates = false;
-  /// A reproducible run: every candidate is searched whatever finetune.candidates_within_s says.
+  /// A reproducible run: every candidate is searched, and every iteration, whatever
+  /// finetune.candidates_within_s and max_search_s say.
   bool reproducible = false;
   /// When the training began (its TD3 phase, or `auvrl finetune`): finetune.candidates_within_s
   /// counts from here.

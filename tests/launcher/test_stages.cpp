@@ -44,6 +44,23 @@ TrainOptions fast_run_directory(const fs::path& tmp, const std::string& name = "
   return options;
 }
 
+/// A fast-preset run directory of seed 4 whose policy.nn is the committed policy (what
+/// `auvrl finetune` starts from): the run's options.
+TrainOptions run_with_committed_policy(const fs::path& tmp) {
+  const TrainOptions options = fast_run_directory(tmp, "run", 4);
+  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn",
+                fs::path(options.run_dir) / "policy.nn");
+  return options;
+}
+
+/// The policy an output directory's evaluation names (eval/selected_policy.txt).
+std::string evaluated_policy(const fs::path& out_dir) {
+  std::ifstream selected(out_dir / "eval" / "selected_policy.txt");
+  std::string evaluated;
+  std::getline(selected, evaluated);
+  return evaluated;
+}
+
 TEST(RunDirectoryTest, ANewRunGetsItsFoldersAndAConfigCopyWithAnAbsoluteVehicle) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_rundir_");
   TrainOptions options;
@@ -318,13 +335,9 @@ TEST(MaxSearchTest, ASearchEndsWhenItsNextIterationWouldEndPastTheCap) {
 // best validated weights, as at its last iteration, and no further candidate starts.
 TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  const TrainOptions options = fast_run_directory(tmp, "run", 4);
+  const TrainOptions options = run_with_committed_policy(tmp);
   const std::string policy = (tmp / "run" / "policy.nn").string();
-  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
-  std::ifstream preset(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
-  std::ostringstream text;
-  text << preset.rdbuf();
-  std::string yaml = text.str();
+  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
   // The preset's cap replaced by one that the first iteration already passes.
   const std::size_t own = yaml.find("\n  max_search_s: ");
   ASSERT_NE(own, std::string::npos);
@@ -346,9 +359,7 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   EXPECT_EQ(rows[0].at("iteration"), "1");
   EXPECT_FALSE(rows[0].at("validation_reached").empty());
   EXPECT_FALSE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
-  std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
-  std::string evaluated;
-  std::getline(selected, evaluated);
+  const std::string evaluated = evaluated_policy(tmp / "again");
   EXPECT_TRUE(evaluated == policy || evaluated == o.out_dir + "/policy_finetuned.nn") << evaluated;
 }
 
@@ -358,9 +369,8 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
 // search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  const TrainOptions options = fast_run_directory(tmp, "run", 4);
+  const TrainOptions options = run_with_committed_policy(tmp);
   const std::string policy = (tmp / "run" / "policy.nn").string();
-  fs::copy_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn", policy);
   RefinetuneOptions o;
   o.run_dir = options.run_dir;
   o.out_dir = (tmp / "again").string();
@@ -394,10 +404,7 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   EXPECT_THROW(refinetune(too_many, refused), std::invalid_argument);
   EXPECT_FALSE(fs::exists(too_many.out_dir));
   // The chosen search's weights are the ones evaluated (the trained policy where it kept none).
-  std::ifstream selected(tmp / "again" / "eval" / "selected_policy.txt");
-  std::string evaluated;
-  std::getline(selected, evaluated);
-  EXPECT_EQ(evaluated,
+  EXPECT_EQ(evaluated_policy(tmp / "again"),
             rows[chosen].at("kept_iteration") == "0" ? policy : o.out_dir + "/policy_finetuned.nn")
       << out.str();
 }
