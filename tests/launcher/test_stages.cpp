@@ -53,6 +53,17 @@ TrainOptions run_with_committed_policy(const fs::path& tmp) {
   return options;
 }
 
+/// `auvrl finetune` of a run_with_committed_policy run in tmp into tmp/again: `candidates`
+/// searches of `iterations` each.
+RefinetuneOptions refinetune_committed_policy(const fs::path& tmp, int iterations, int candidates) {
+  RefinetuneOptions o;
+  o.run_dir = run_with_committed_policy(tmp).run_dir;
+  o.out_dir = (tmp / "again").string();
+  o.iterations = iterations;
+  o.candidates = candidates;
+  return o;
+}
+
 /// The policy an output directory's evaluation names (eval/selected_policy.txt).
 std::string evaluated_policy(const fs::path& out_dir) {
   std::ifstream selected(out_dir / "eval" / "selected_policy.txt");
@@ -335,7 +346,7 @@ TEST(MaxSearchTest, ASearchEndsWhenItsNextIterationWouldEndPastTheCap) {
 // best validated weights, as at its last iteration, and no further candidate starts.
 TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  const TrainOptions options = run_with_committed_policy(tmp);
+  RefinetuneOptions o = refinetune_committed_policy(tmp, 5, 2);
   const std::string policy = (tmp / "run" / "policy.nn").string();
   std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
   // The preset's cap replaced by one that the first iteration already passes.
@@ -344,12 +355,7 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   yaml.replace(own, yaml.find('\n', own + 1) - own, "\n  max_search_s: 0.001");
   const fs::path config = tmp / "capped.yaml";
   std::ofstream(config) << yaml;
-  RefinetuneOptions o;
-  o.run_dir = options.run_dir;
   o.config_path = config.string();
-  o.out_dir = (tmp / "again").string();
-  o.iterations = 5;
-  o.candidates = 2;
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
   EXPECT_NE(out.str().find("ended after iteration 1 of 5"), std::string::npos) << out.str();
@@ -369,13 +375,8 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
 // search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
-  const TrainOptions options = run_with_committed_policy(tmp);
+  const RefinetuneOptions o = refinetune_committed_policy(tmp, 2, 2);
   const std::string policy = (tmp / "run" / "policy.nn").string();
-  RefinetuneOptions o;
-  o.run_dir = options.run_dir;
-  o.out_dir = (tmp / "again").string();
-  o.iterations = 2;
-  o.candidates = 2;
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
   EXPECT_TRUE(fs::exists(tmp / "again" / "finetune.csv"));
