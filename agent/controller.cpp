@@ -48,18 +48,14 @@ void PolicyController::use_driving_aids(const task::TaskConfig& task) {
 
 void PolicyController::act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
                            const task::StateVector& state, task::ActionVector& action) {
-  if (driving_task_) {
-    act_on_estimates(observation, goal_ned_m, state, action);
-  } else {
-    action = network_.forward(state);
-  }
-  if (fault_accommodation_) fault_accommodation_->apply(state, action);
+  action = network_.forward(network_input(observation, goal_ned_m, state));
+  finish_action(state, action);
 }
 
-void PolicyController::act_on_estimates(const task::Observation& observation,
-                                        const Eigen::Vector3d& goal_ned_m,
-                                        const task::StateVector& state,
-                                        task::ActionVector& action) {
+const task::StateVector& PolicyController::network_input(const task::Observation& observation,
+                                                         const Eigen::Vector3d& goal_ned_m,
+                                                         const task::StateVector& state) {
+  if (!driving_task_) return state;
   const task::TaskConfig& task = *driving_task_;
   const Eigen::Vector3d position_ned_m =
       position_filter_ ? position_filter_->update(observation) : observation.position_ned_m;
@@ -71,7 +67,11 @@ void PolicyController::act_on_estimates(const task::Observation& observation,
   // Zero shift without the filter: the state's position entries stay the measured ones.
   task::relabel_state(task, goal_ned_m, shown_goal_ned_m,
                       position_ned_m - observation.position_ned_m, moved_state_);
-  action = network_.forward(moved_state_);
+  return moved_state_;
+}
+
+void PolicyController::finish_action(const task::StateVector& state, task::ActionVector& action) {
+  if (fault_accommodation_) fault_accommodation_->apply(state, action);
 }
 
 namespace {

@@ -50,6 +50,15 @@ class PolicyController final : public Controller {
   }
   void act(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
            const task::StateVector& state, task::ActionVector& action) override;
+  /// act() in two halves around the network, for a network run elsewhere (batched over
+  /// episodes: run_policy_episodes): what the network is shown this step (the state, or with the
+  /// driving aids the state with the filter's position and the integrator's goal; it advances
+  /// them, so once per step), and the network's output made the command (the fault
+  /// accommodation, where on). act() is network_input, the network, finish_action.
+  const task::StateVector& network_input(const task::Observation& observation,
+                                         const Eigen::Vector3d& goal_ned_m,
+                                         const task::StateVector& state);
+  void finish_action(const task::StateVector& state, task::ActionVector& action);
   /// The integrator's goal offset now, NED, m.
   const Eigen::Vector3d& goal_offset_ned_m() const { return goal_offset_ned_m_; }
   std::string name() const override { return "policy"; }
@@ -61,9 +70,6 @@ class PolicyController final : public Controller {
   nn::Mlp network_;
   int state_dim_;
   int num_thrusters_;
-  /// The network on the state with the integrator's goal and the filter's position.
-  void act_on_estimates(const task::Observation& observation, const Eigen::Vector3d& goal_ned_m,
-                        const task::StateVector& state, task::ActionVector& action);
 
   std::optional<task::TaskConfig> driving_task_;  ///< set when integral action or filter is on
   std::optional<task::PositionFilter> position_filter_;

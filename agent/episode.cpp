@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "common/random.hpp"
 
@@ -45,15 +47,6 @@ void ExplorationNoise::apply(task::ActionVector& action) {
   }
 }
 
-namespace {
-/// A report the task can use: a NaN or infinity anywhere (not only in the position) would
-/// otherwise reach the state vector and the learner's replay buffer.
-bool usable(const VehicleReport& r) {
-  const task::Observation& o = r.observation;
-  return !r.blown_up && o.position_ned_m.allFinite() && o.euler_rpy_rad.allFinite() &&
-         o.velocity_body_mps.allFinite() && o.angular_rate_body_rad_s.allFinite();
-}
-
 /// What an episode measures of where the vehicle went, step by step: the distances, the thrust
 /// energy, the first arrival within the reach radius and the mean error from then on.
 class EpisodeFigures {
@@ -93,6 +86,15 @@ class EpisodeFigures {
   int steps_after_reach_ = 0;
 };
 
+namespace {
+/// A report the task can use: a NaN or infinity anywhere (not only in the position) would
+/// otherwise reach the state vector and the learner's replay buffer.
+bool usable(const VehicleReport& r) {
+  const task::Observation& o = r.observation;
+  return !r.blown_up && o.position_ned_m.allFinite() && o.euler_rpy_rad.allFinite() &&
+         o.velocity_body_mps.allFinite() && o.angular_rate_body_rad_s.allFinite();
+}
+
 /// After step `step` of an episode: whether it stops, recording why in `summary`. An episode
 /// that reached its goal with options.run_full_time goes on (`task_ended` set: no more
 /// transitions or return), so that the evaluation sees the vehicle hold station.
@@ -115,98 +117,160 @@ bool episode_stops(const task::StepOutcome& outcome, const EpisodeOptions& optio
 }
 }  // namespace
 
-EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
-                           const EpisodeOptions& options) {
+EpisodeStepper::EpisodeStepper(const task::TaskConfig& task, VehicleLink& link,
+                               Controller& controller, const EpisodeOptions& options)
+    : task_(task),
+      link_(link),
+      options_(options),
+      figures_(std::make_unique<EpisodeFigures>(summary_, options.reach_radius_m,
+                                                task.control_step_s)) {
   const int n = link.num_thrusters();
   if (n != task.num_thrusters) {
     throw std::invalid_argument("the vehicle has " + std::to_string(n) +
                                 " thrusters, the task expects " +
                                 std::to_string(task.num_thrusters));
   }
-  EpisodeSummary summary;
   controller.reset();
   if (options.expert) options.expert->reset();
   if (options.noise) options.noise->reset();
 
-  std::optional<VehicleReport> report = link.reset(options.start);
-  if (!report) {
-    summary.end_reason = task::EndReason::kSimTimeout;
-    return summary;
+  report_ = link.reset(options.start);
+  if (!report_) {
+    summary_.end_reason = task::EndReason::kSimTimeout;
+    return;
   }
-  if (!usable(*report)) {
-    summary.end_reason = task::EndReason::kBlowUp;
-    return summary;
+  if (!usable(*report_)) {
+    summary_.end_reason = task::EndReason::kBlowUp;
+    return;
   }
-  const Eigen::Vector3d& goal = options.goal_ned_m;
-  task::ActionVector previous_action = task::ActionVector::Zero(n);
-  task::ActionVector action(n);
-  task::ActionVector expert_action;
-  task::StateVector state, next_state;
-  task::build_state(task, report->observation, goal, previous_action, state,
-                    report->thrust_realised_n);
-  double distance = (goal - report->observation.position_ned_m).norm();
+  previous_action_ = task::ActionVector::Zero(n);
+  action_.resize(n);
+  task::build_state(task, report_->observation, options.goal_ned_m, previous_action_, state_,
+                    report_->thrust_realised_n);
+  distance_m_ = (options.goal_ned_m - report_->observation.position_ned_m).norm();
+  summary_.min_distance_m = true_distance_m(*report_, distance_m_);
+  thrust_n_.resize(static_cast<std::size_t>(n));
+  running_ = task.max_steps >= 1;
+}
+
+EpisodeStepper::~EpisodeStepper() = default;
+
+double EpisodeStepper::true_distance_m(const VehicleReport& r, double reported_m) const {
   // The figures measure where the vehicle is: its true position where the link knows it (a
   // simulator in process, whose sensor noise only the controller sees), else what it reports.
-  const auto true_distance = [&goal](const VehicleReport& r, double reported_m) {
-    return r.true_position_ned_m ? (goal - *r.true_position_ned_m).norm() : reported_m;
-  };
-  summary.min_distance_m = true_distance(*report, distance);
-  std::vector<double> thrust_n(static_cast<std::size_t>(n));
-  EpisodeFigures figures(summary, options.reach_radius_m, task.control_step_s);
-  bool task_ended = false;  // reached (when running the full time anyway)
+  return r.true_position_ned_m ? (options_.goal_ned_m - *r.true_position_ned_m).norm() : reported_m;
+}
 
-  for (int t = 1; t <= task.max_steps; ++t) {
-    controller.act(report->observation, goal, state, action);
-    if (options.expert) options.expert->act(report->observation, goal, state, expert_action);
-    if (options.noise) options.noise->apply(action);
-    for (int i = 0; i < n; ++i) {
-      thrust_n[static_cast<std::size_t>(i)] = static_cast<double>(action[i]) * task.max_thrust_n;
-    }
-    std::optional<VehicleReport> next = link.step(thrust_n);
-    if (!next) {
-      summary.end_reason = task::EndReason::kSimTimeout;
-      break;
-    }
-    if (!usable(*next)) {
-      summary.end_reason = task::EndReason::kBlowUp;
-      break;
-    }
-    const double next_distance = (goal - next->observation.position_ned_m).norm();
-    const task::StepOutcome outcome = task::evaluate_step(
-        task, distance, next_distance, task::is_flipped(task, next->observation.euler_rpy_rad),
-        action, options.beta_m, t, previous_action);
-    task::build_state(task, next->observation, goal, action, next_state, next->thrust_realised_n);
+void EpisodeStepper::step() {
+  if (!running_) throw std::logic_error("EpisodeStepper::step: the episode is over");
+  const task::TaskConfig& task = task_;
+  const EpisodeOptions& options = options_;
+  const Eigen::Vector3d& goal = options.goal_ned_m;
+  const int t = ++step_;
+  if (options.expert) options.expert->act(report_->observation, goal, state_, expert_action_);
+  if (options.noise) options.noise->apply(action_);
+  for (std::size_t i = 0; i < thrust_n_.size(); ++i) {
+    thrust_n_[i] = static_cast<double>(action_[static_cast<Eigen::Index>(i)]) * task.max_thrust_n;
+  }
+  std::optional<VehicleReport> next = link_.step(thrust_n_);
+  running_ = false;  // until this step is through
+  if (!next) {
+    summary_.end_reason = task::EndReason::kSimTimeout;
+    return;
+  }
+  if (!usable(*next)) {
+    summary_.end_reason = task::EndReason::kBlowUp;
+    return;
+  }
+  const double next_distance = (goal - next->observation.position_ned_m).norm();
+  const task::StepOutcome outcome = task::evaluate_step(
+      task, distance_m_, next_distance, task::is_flipped(task, next->observation.euler_rpy_rad),
+      action_, options.beta_m, t, previous_action_);
+  task::build_state(task, next->observation, goal, action_, next_state_, next->thrust_realised_n);
 
-    if (!task_ended) {
-      if (options.on_transition) {
-        Transition tr{state,      action,           outcome.reward,
-                      next_state, outcome.terminal, next->observation.position_ned_m,
-                      t - 1,      expert_action};
-        options.on_transition(tr);
-      }
-      summary.episode_return += outcome.reward;
+  if (!task_ended_) {
+    if (options.on_transition) {
+      Transition tr{state_,      action_,           outcome.reward,
+                    next_state_, outcome.terminal, next->observation.position_ned_m,
+                    t - 1,       expert_action_};
+      options.on_transition(tr);
     }
-    const double measured_m = true_distance(*next, next_distance);
-    figures.record(t, action, measured_m);
-    if (outcome.inside_goal) summary.success = true;
-    if (options.trajectory) {
-      options.trajectory->push_back(
-          {next->time_s, next->observation, thrust_n, next->thrust_realised_n, measured_m});
-    }
+    summary_.episode_return += outcome.reward;
+  }
+  const double measured_m = true_distance_m(*next, next_distance);
+  figures_->record(t, action_, measured_m);
+  if (outcome.inside_goal) summary_.success = true;
+  if (options.trajectory) {
+    options.trajectory->push_back(
+        {next->time_s, next->observation, thrust_n_, next->thrust_realised_n, measured_m});
+  }
 
-    report = std::move(next);
-    state.swap(next_state);
-    previous_action = action;
-    distance = next_distance;
-    if (episode_stops(outcome, options, t, task.max_steps, figures.steps_after_reach(), summary,
-                      task_ended)) {
-      break;
+  report_ = std::move(next);
+  state_.swap(next_state_);
+  previous_action_ = action_;
+  distance_m_ = next_distance;
+  running_ = !episode_stops(outcome, options, t, task.max_steps, figures_->steps_after_reach(),
+                            summary_, task_ended_) &&
+             t < task.max_steps;
+}
+
+EpisodeSummary EpisodeStepper::finish() {
+  running_ = false;
+  if (summary_.end_reason == task::EndReason::kNone) {
+    summary_.end_reason = task::EndReason::kTimeLimit;
+  }
+  figures_->finish();
+  return summary_;
+}
+
+EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
+                           const EpisodeOptions& options) {
+  EpisodeStepper episode(task, link, controller, options);
+  while (episode.running()) {
+    controller.act(episode.observation(), options.goal_ned_m, episode.state(), episode.action());
+    episode.step();
+  }
+  return episode.finish();
+}
+
+std::vector<EpisodeSummary> run_policy_episodes(nn::Mlp& network,
+                                                const std::vector<PolicyEpisode>& episodes) {
+  const auto count = static_cast<Eigen::Index>(episodes.size());
+  if (count > network.max_batch()) {
+    throw std::invalid_argument("run_policy_episodes: " + std::to_string(count) +
+                                " episodes, more than the network's batch of " +
+                                std::to_string(network.max_batch()));
+  }
+  std::vector<std::unique_ptr<EpisodeStepper>> steppers;
+  steppers.reserve(episodes.size());
+  for (const PolicyEpisode& e : episodes) {
+    steppers.push_back(
+        std::make_unique<EpisodeStepper>(*e.task, *e.link, *e.controller, *e.options));
+  }
+  Eigen::MatrixXf input(network.spec().input_dim, count);
+  std::vector<std::size_t> active;
+  for (;;) {
+    active.clear();
+    for (std::size_t i = 0; i < steppers.size(); ++i) {
+      if (!steppers[i]->running()) continue;
+      const EpisodeStepper& s = *steppers[i];
+      input.col(static_cast<Eigen::Index>(active.size())) = episodes[i].controller->network_input(
+          s.observation(), episodes[i].options->goal_ned_m, s.state());
+      active.push_back(i);
+    }
+    if (active.empty()) break;
+    const auto output = network.forward(input.leftCols(static_cast<Eigen::Index>(active.size())));
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      EpisodeStepper& s = *steppers[active[k]];
+      s.action() = output.col(static_cast<Eigen::Index>(k));
+      episodes[active[k]].controller->finish_action(s.state(), s.action());
+      s.step();
     }
   }
-  if (summary.end_reason == task::EndReason::kNone)
-    summary.end_reason = task::EndReason::kTimeLimit;
-  figures.finish();
-  return summary;
+  std::vector<EpisodeSummary> summaries;
+  summaries.reserve(steppers.size());
+  for (const auto& s : steppers) summaries.push_back(s->finish());
+  return summaries;
 }
 
 }  // namespace auvrl::agent

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <random>
 #include <vector>
@@ -102,5 +103,69 @@ struct EpisodeOptions {
 /// with kBlowUp for a numerical blow-up); no transition after that point is reported.
 EpisodeSummary run_episode(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
                            const EpisodeOptions& options);
+
+class EpisodeFigures;
+
+/// One episode stepped by its caller: run_episode's loop with the controller's turn left out,
+/// so that several episodes can share one batched pass of a network (run_policy_episodes). The
+/// constructor resets the controller, the expert, the noise and the vehicle; then, while
+/// running(), the controller fills action() from observation() and state(), and step() carries
+/// it out; finish() gives the summary. run_episode is exactly that loop.
+class EpisodeStepper {
+ public:
+  /// Throws std::invalid_argument if the vehicle's thruster count is not the task's.
+  EpisodeStepper(const task::TaskConfig& task, VehicleLink& link, Controller& controller,
+                 const EpisodeOptions& options);
+  ~EpisodeStepper();
+  EpisodeStepper(const EpisodeStepper&) = delete;
+  EpisodeStepper& operator=(const EpisodeStepper&) = delete;
+
+  /// Whether the episode wants another action.
+  bool running() const { return running_; }
+  const task::Observation& observation() const { return report_->observation; }
+  /// The task's observation vector of this step.
+  const task::StateVector& state() const { return state_; }
+  /// This step's command, for the controller to fill.
+  task::ActionVector& action() { return action_; }
+  /// Commands action(), observes and rewards (the expert's label and the noise first).
+  void step();
+  /// The summary, once the episode is over (or to end it early).
+  EpisodeSummary finish();
+
+ private:
+  double true_distance_m(const VehicleReport& r, double reported_m) const;
+
+  const task::TaskConfig& task_;
+  VehicleLink& link_;
+  const EpisodeOptions& options_;
+  EpisodeSummary summary_;
+  std::unique_ptr<EpisodeFigures> figures_;
+  std::optional<VehicleReport> report_;
+  task::ActionVector previous_action_, action_, expert_action_;
+  task::StateVector state_, next_state_;
+  std::vector<double> thrust_n_;
+  double distance_m_ = 0.0;
+  int step_ = 0;
+  bool task_ended_ = false;  ///< reached (when running the full time anyway)
+  bool running_ = false;
+};
+
+/// One of the episodes run_policy_episodes runs together: its task, vehicle, options, and the
+/// policy controller whose driving aids (integrator, position filter, fault accommodation) it
+/// uses; that controller's own network is not used.
+struct PolicyEpisode {
+  const task::TaskConfig* task = nullptr;
+  VehicleLink* link = nullptr;
+  PolicyController* controller = nullptr;
+  const EpisodeOptions* options = nullptr;
+};
+
+/// Runs the episodes in lockstep, each step's commands from one batched pass of `network` over
+/// the episodes still running: the summaries (and trajectories and transitions) run_episode
+/// gives each with its controller driving `network`, to the bit where the network's columns
+/// are computed as one sample is (nn::Mlp on AVX-512). Throws std::invalid_argument for more
+/// episodes than network.max_batch().
+std::vector<EpisodeSummary> run_policy_episodes(nn::Mlp& network,
+                                                const std::vector<PolicyEpisode>& episodes);
 
 }  // namespace auvrl::agent

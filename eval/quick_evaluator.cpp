@@ -1,8 +1,10 @@
 #include "eval/quick_evaluator.hpp"
 
+#include <algorithm>
 #include <random>
 
 #include "agent/pid_controller.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 
 namespace auvrl::eval {
@@ -27,9 +29,22 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
   reference_ = run(pid);
 }
 
-ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network) const {
-  agent::PolicyController controller(network, task_);
-  return score_against_reference(run(controller), reference_);
+ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network, int threads) const {
+  if (threads <= 1) {
+    agent::PolicyController controller(network, task_);
+    return score_against_reference(run(controller), reference_);
+  }
+  // A controller per thread; each way-point's row in its own slot, the same rows as one thread.
+  const int used = std::min<int>(threads, static_cast<int>(episodes_.size()));
+  std::vector<agent::PolicyController> controllers;
+  for (int w = 0; w < used; ++w) controllers.emplace_back(network, task_);
+  std::vector<SummaryRow> rows(episodes_.size());
+  for_each_index(used, episodes_.size(), [&](int w, std::size_t i) {
+    rows[i] = run_evaluation_episode(model_, config_,
+                                     controllers[static_cast<std::size_t>(w)], episodes_[i],
+                                     nullptr);
+  });
+  return score_against_reference(rows, reference_);
 }
 
 std::vector<SummaryRow> QuickEvaluator::run(agent::Controller& controller) const {

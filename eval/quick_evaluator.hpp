@@ -25,8 +25,9 @@ class QuickEvaluator {
   QuickEvaluator(const sim::VehicleModel& model, const task::TaskConfig& task, int suite_episodes,
                  int turned = 0);
 
-  /// Runs the policy on the validation way-points and scores it against the PID's runs.
-  ValidationScore evaluate(const nn::Mlp& network) const;
+  /// Runs the policy on the validation way-points and scores it against the PID's runs, on
+  /// `threads` threads (the same score on any number).
+  ValidationScore evaluate(const nn::Mlp& network, int threads = 1) const;
 
  private:
   std::vector<SummaryRow> run(agent::Controller& controller) const;

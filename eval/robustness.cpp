@@ -7,12 +7,15 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <memory>
 #include <ostream>
 #include <stdexcept>
 
 #include "agent/pid_controller.hpp"
 #include "common/csv.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 
 namespace auvrl::eval {
@@ -524,25 +527,26 @@ std::vector<EvaluationEpisode> facing_away_episodes(const EvaluationConfig& conf
   return episodes;
 }
 
-std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
-                                           agent::Controller& controller,
-                                           const std::vector<EvaluationEpisode>& episodes) {
+namespace {
+
+/// The config as the drawn episodes run it (the model's thrusters, config.episode_steps);
+/// throws std::invalid_argument for a task that does not validate or a reach radius not > 0.
+EvaluationConfig drawn_episodes_config(const sim::VehicleModel& model, EvaluationConfig config) {
   task::apply_vehicle(model.facts(), config.task);
   config.task.max_steps = config.episode_steps;  // checked here; each episode applies it
   config.task.validate();
   if (!(config.reach_radius_m > 0)) {
     throw std::invalid_argument("robustness: reach radius must be > 0");
   }
-  std::vector<SummaryRow> rows;
-  for (const EvaluationEpisode& episode : episodes) {
-    rows.push_back(run_evaluation_episode(model, config, controller, episode, nullptr));
-  }
-  return rows;
+  return config;
 }
 
-RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
-                                agent::Controller& controller, int episodes_per_group,
-                                std::uint64_t seed, const std::string& out_dir) {
+/// Runs the suite's episodes with run_rows, then its groups and (out_dir) its files.
+RobustnessResult run_robustness_with(
+    const sim::VehicleModel& model, const EvaluationConfig& config, int episodes_per_group,
+    std::uint64_t seed, const std::string& out_dir,
+    const std::function<std::vector<SummaryRow>(const std::vector<EvaluationEpisode>&)>&
+        run_rows) {
   if (!out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
@@ -551,7 +555,7 @@ RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig
   RobustnessResult result;
   result.episodes = robustness_episodes(config, model.num_thrusters(), episodes_per_group, seed);
   const auto started = std::chrono::steady_clock::now();
-  result.rows = run_drawn_episodes(model, config, controller, result.episodes);
+  result.rows = run_rows(result.episodes);
   result.elapsed_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   result.groups = group_metrics(result.rows, config.reach_radius_m);
@@ -565,6 +569,55 @@ RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig
     write_vehicle_csv((dir / "vehicle.csv").string(), model.facts());
   }
   return result;
+}
+
+}  // namespace
+
+std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
+                                           agent::Controller& controller,
+                                           const std::vector<EvaluationEpisode>& episodes) {
+  config = drawn_episodes_config(model, std::move(config));
+  std::vector<SummaryRow> rows;
+  for (const EvaluationEpisode& episode : episodes) {
+    rows.push_back(run_evaluation_episode(model, config, controller, episode, nullptr));
+  }
+  return rows;
+}
+
+std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
+                                           const ControllerFactory& make_controller,
+                                           const std::vector<EvaluationEpisode>& episodes,
+                                           int threads) {
+  config = drawn_episodes_config(model, std::move(config));
+  const int used = std::max(1, std::min<int>(threads, static_cast<int>(episodes.size())));
+  std::vector<std::unique_ptr<agent::Controller>> controllers;
+  for (int w = 0; w < used; ++w) controllers.push_back(make_controller());
+  std::vector<SummaryRow> rows(episodes.size());
+  for_each_index(used, episodes.size(), [&](int w, std::size_t i) {
+    rows[i] = run_evaluation_episode(model, config, *controllers[static_cast<std::size_t>(w)],
+                                     episodes[i], nullptr);
+  });
+  return rows;
+}
+
+RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
+                                agent::Controller& controller, int episodes_per_group,
+                                std::uint64_t seed, const std::string& out_dir) {
+  return run_robustness_with(model, config, episodes_per_group, seed, out_dir,
+                             [&](const std::vector<EvaluationEpisode>& episodes) {
+                               return run_drawn_episodes(model, config, controller, episodes);
+                             });
+}
+
+RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
+                                const ControllerFactory& make_controller, int threads,
+                                int episodes_per_group, std::uint64_t seed,
+                                const std::string& out_dir) {
+  return run_robustness_with(
+      model, config, episodes_per_group, seed, out_dir,
+      [&](const std::vector<EvaluationEpisode>& episodes) {
+        return run_drawn_episodes(model, config, make_controller, episodes, threads);
+      });
 }
 
 namespace {

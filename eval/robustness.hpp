@@ -53,6 +53,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <iosfwd>
 #include <limits>
 #include <string>
@@ -270,6 +272,16 @@ std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, Evalu
                                            agent::Controller& controller,
                                            const std::vector<EvaluationEpisode>& episodes);
 
+/// Makes a controller for one thread of the episodes (each thread drives with its own).
+using ControllerFactory = std::function<std::unique_ptr<agent::Controller>()>;
+
+/// run_drawn_episodes on `threads` threads, each driving with its own controller from
+/// make_controller: the same rows as one controller on one thread.
+std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, EvaluationConfig config,
+                                           const ControllerFactory& make_controller,
+                                           const std::vector<EvaluationEpisode>& episodes,
+                                           int threads);
+
 /// Runs the suite (one episode after another: deterministic) and, with a non-empty out_dir,
 /// creates it and writes robustness_episodes.csv, robustness.csv and vehicle.csv; throws
 /// std::runtime_error naming a path it cannot write. The config's task gets the model's
@@ -277,6 +289,11 @@ std::vector<SummaryRow> run_drawn_episodes(const sim::VehicleModel& model, Evalu
 RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
                                 agent::Controller& controller, int episodes_per_group,
                                 std::uint64_t seed, const std::string& out_dir);
+/// run_robustness with the episodes on `threads` threads (run_drawn_episodes): the same result.
+RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig config,
+                                const ControllerFactory& make_controller, int threads,
+                                int episodes_per_group, std::uint64_t seed,
+                                const std::string& out_dir);
 
 /// Writes robustness_episodes.csv (columns in docs/usage.md); rows[i] is episodes[i]'s.
 void write_robustness_episodes_csv(const std::string& path,

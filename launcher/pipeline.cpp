@@ -178,10 +178,9 @@ double seconds_since(std::chrono::steady_clock::time_point since) {
 
 /// Runs candidate `index`'s search from `start` (validated as `before`), its progress to its
 /// finetune.csv, validating every validate_every iterations and at the end, or where
-/// search_past_cap ends it (searches_start: the first search's start).
+/// search_past_cap ends it.
 CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& start,
                                  const eval::ValidationScore& before, int index,
-                                 std::chrono::steady_clock::time_point searches_start,
                                  std::ostream& out) {
   constexpr int validate_every = 10;
   const eval::Ranking ranking = finetune_ranking(in.config, in.max_hold_m);
@@ -196,8 +195,7 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
                                 : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
   bool past_cap = false;  // the search ends after this iteration (search_past_cap)
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
-    if (const auto why = search_past_cap(in.config, in.reproducible, seconds_since(searches_start),
-                                         it.elapsed_s, it.iteration)) {
+    if (const auto why = search_past_cap(in.config, in.reproducible, it.elapsed_s, it.iteration)) {
       out << "auvrl train: fine-tuning" << label << ": " << *why << "\n";
       past_cap = true;
     }
@@ -209,7 +207,7 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
       nn::save_network_file((iterates / fmt::format("iteration_{:03d}.nn", it.iteration)).string(),
                             weights);
     }
-    const eval::ValidationScore score = in.validation.evaluate(weights);
+    const eval::ValidationScore score = in.validation.evaluate(weights, tuning::search_threads(in.config));
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
     if (eval::ranks_above(score, best.score, ranking)) best = {score, weights, it.iteration};
     out << fmt::format(
@@ -246,7 +244,7 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
       break;
     }
     try {
-      searches.push_back(search_candidate(in, start, before, index, searches_start, out));
+      searches.push_back(search_candidate(in, start, before, index, out));
     } catch (const std::exception& e) {
       if (searches.empty()) throw;
       out << "auvrl train: fine-tuning candidate " << index + 1 << " failed: " << e.what()
@@ -265,7 +263,9 @@ CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& s
                                   const eval::ValidationScore& before, std::ostream& out) {
   std::vector<CandidateSearch> searches = run_candidate_searches(in, start, before, out);
   if (searches.size() == 1) return std::move(searches.front());  // nothing to choose between
-  const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed);
+  const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed,
+                                       eval::kRobustnessEpisodesPerGroup,
+                                       tuning::search_threads(in.config));
   std::vector<tuning::CandidateScore> scores;
   std::vector<CandidatesRow> rows;
   for (const CandidateSearch& c : searches) {
@@ -302,7 +302,7 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       "way-points{})\n",
       start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes,
       in.config.candidates == 1 ? "" : fmt::format("; {} candidates", in.config.candidates));
-  const eval::ValidationScore before = in.validation.evaluate(start);
+  const eval::ValidationScore before = in.validation.evaluate(start, tuning::search_threads(in.config));
   const CandidateSearch search = search_candidates(in, start, before, out);
   const FinetuneBest& best = search.best;
   out << fmt::format("auvrl train: fine-tuned: objective {:.3f} -> {:.3f} s\n",
@@ -359,25 +359,19 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
         "choosing among these",
         searched, training_s + pace_s, config.candidates_within_s);
   }
-  if (next_ends_past(config.max_search_s, searches_s, searches_s, done)) {
-    return fmt::format(
-        "{}; another would end at about {:.1f} s of searching, past finetune.max_search_s "
-        "({:g} s): choosing among these",
-        searched, searches_s + pace_s, config.max_search_s);
-  }
   return std::nullopt;
 }
 
 std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
-                                           double searches_s, double search_s, int done) {
+                                           double search_s, int done) {
   if (reproducible || done < 1 || done >= config.iterations ||
-      !next_ends_past(config.max_search_s, searches_s, search_s, done)) {
+      !next_ends_past(config.max_search_s, search_s, search_s, done)) {
     return std::nullopt;
   }
   return fmt::format(
       "ended after iteration {} of {} at {:.1f} s of searching; the next would end at about "
       "{:.1f} s, past finetune.max_search_s ({:g} s)",
-      done, config.iterations, searches_s, searches_s + search_s / done, config.max_search_s);
+      done, config.iterations, search_s, search_s + search_s / done, config.max_search_s);
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {

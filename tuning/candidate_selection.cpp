@@ -18,14 +18,16 @@ eval::EvaluationConfig suite_config(const task::TaskConfig& task, std::uint64_t 
   return config;
 }
 
-/// The policy's groups on the suite drawn at seed, driving as the task says.
-std::vector<eval::GroupMetrics> policy_groups(const sim::VehicleModel& model,
-                                              const task::TaskConfig& task, std::uint64_t seed,
-                                              int episodes_per_group, const nn::Mlp& policy) {
-  agent::PolicyController controller(policy, task);
-  return eval::run_robustness(model, suite_config(task, seed), controller, episodes_per_group, seed,
-                              "")
-      .groups;
+/// The policy driving as the task says, a controller per thread.
+eval::ControllerFactory policy_controllers(const nn::Mlp& policy, const task::TaskConfig& task) {
+  return [&policy, &task] { return std::make_unique<agent::PolicyController>(policy, task); };
+}
+
+/// The PID baseline of the model's gains, a controller per thread.
+eval::ControllerFactory pid_controllers(const sim::VehicleModel& model) {
+  return [&model] {
+    return std::make_unique<agent::PidController>(model, agent::pid_gains_for(model).gains);
+  };
 }
 
 /// Refuses the evaluation's own draw for a choice.
@@ -60,21 +62,28 @@ std::uint64_t candidate_seed(std::uint64_t run_seed, int index) {
 }
 
 SuiteSelector::SuiteSelector(const sim::VehicleModel& model, const task::TaskConfig& task,
-                             std::uint64_t seed, int episodes_per_group)
-    : model_(model), task_(task), seed_(seed), episodes_per_group_(episodes_per_group) {
+                             std::uint64_t seed, int episodes_per_group, int threads)
+    : model_(model),
+      task_(task),
+      seed_(seed),
+      episodes_per_group_(episodes_per_group),
+      threads_(threads) {
   require_validation_seed(seed, "the candidates");
-  agent::PidController pid(model, agent::pid_gains_for(model).gains);
-  pid_groups_ =
-      eval::run_robustness(model, suite_config(task_, seed_), pid, episodes_per_group_, seed_, "")
-          .groups;
+  const eval::ControllerFactory pid = pid_controllers(model);
+  pid_groups_ = eval::run_robustness(model, suite_config(task_, seed_), pid, threads_,
+                                     episodes_per_group_, seed_, "")
+                    .groups;
   behind_ = eval::facing_away_episodes(suite_config(task_, seed_), model.num_thrusters(),
                                        kBehindEpisodes, seed_);
-  pid_behind_ = eval::run_drawn_episodes(model, suite_config(task_, seed_), pid, behind_);
+  pid_behind_ = eval::run_drawn_episodes(model, suite_config(task_, seed_), pid, behind_, threads_);
 }
 
 std::vector<eval::GroupComparison> SuiteSelector::compare(const nn::Mlp& policy) const {
-  return eval::compare_robustness(policy_groups(model_, task_, seed_, episodes_per_group_, policy),
-                                  pid_groups_);
+  const std::vector<eval::GroupMetrics> groups =
+      eval::run_robustness(model_, suite_config(task_, seed_), policy_controllers(policy, task_),
+                           threads_, episodes_per_group_, seed_, "")
+          .groups;
+  return eval::compare_robustness(groups, pid_groups_);
 }
 
 int SuiteSelector::groups_passing(const nn::Mlp& policy) const {
@@ -86,9 +95,9 @@ int SuiteSelector::groups_passing(const nn::Mlp& policy) const {
 CandidateScore SuiteSelector::score(const nn::Mlp& policy) const {
   CandidateScore s;
   s.groups_passing = groups_passing(policy);
-  agent::PolicyController controller(policy, task_);
   s.behind_late = late_arrivals(
-      eval::run_drawn_episodes(model_, suite_config(task_, seed_), controller, behind_),
+      eval::run_drawn_episodes(model_, suite_config(task_, seed_),
+                               policy_controllers(policy, task_), behind_, threads_),
       pid_behind_);
   s.behind_episodes = static_cast<int>(behind_.size());
   return s;
@@ -113,7 +122,9 @@ int suite_failures(const sim::VehicleModel& model, const task::TaskConfig& task,
   require_validation_seed(seed, "the selection");
   int failures = 0;
   for (const eval::GroupMetrics& group :
-       policy_groups(model, task, seed, episodes_per_group, policy)) {
+       eval::run_robustness(model, suite_config(task, seed), policy_controllers(policy, task), 1,
+                            episodes_per_group, seed, "")
+           .groups) {
     failures += group.flips + group.blow_ups;
   }
   return failures;

@@ -49,8 +49,9 @@ class SuiteSelector {
  public:
   /// Throws std::invalid_argument when seed is the evaluation's own (eval::EvaluationConfig's
   /// default seed, the suite's draws the bar is read on).
+  /// Its episodes run on `threads` threads (the same scores on any number).
   SuiteSelector(const sim::VehicleModel& model, const task::TaskConfig& task, std::uint64_t seed,
-                int episodes_per_group = eval::kRobustnessEpisodesPerGroup);
+                int episodes_per_group = eval::kRobustnessEpisodesPerGroup, int threads = 1);
   /// The comparison, group by group, of the policy (integral action as the task says, as it
   /// drives) with the PID.
   std::vector<eval::GroupComparison> compare(const nn::Mlp& policy) const;
@@ -66,6 +67,7 @@ class SuiteSelector {
   task::TaskConfig task_;
   std::uint64_t seed_;
   int episodes_per_group_;
+  int threads_;
   std::vector<eval::GroupMetrics> pid_groups_;
   std::vector<eval::EvaluationEpisode> behind_;
   std::vector<eval::SummaryRow> pid_behind_;

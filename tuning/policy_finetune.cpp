@@ -10,7 +10,6 @@
 #include <random>
 #include <stdexcept>
 #include <string>
-#include <thread>
 
 #include "agent/controller.hpp"
 #include "agent/episode.hpp"
@@ -18,6 +17,7 @@
 #include "agent/vehicle_link.hpp"
 #include "common/nn/adam.hpp"
 #include "common/nn/random.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 #include "eval/robustness.hpp"
 
@@ -241,30 +241,48 @@ Eigen::VectorXf rank_weighted_direction(const std::vector<double>& value,
 
 }  // namespace
 
-ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
-                                       agent::Controller& controller,
-                                       const FinetuneEpisode& episode, const FinetuneConfig& config,
-                                       double reach_radius_m) {
-  sim::VehicleModel plant = model;
-  if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
-  task::TaskConfig t = task;
-  task::apply_vehicle(plant.facts(), t);
-  t.max_steps = episode.max_steps > 0 ? episode.max_steps : config.episode_steps;
-  if (episode.safety_radius_m > 0.0) t.beta_max_m = episode.safety_radius_m;
-  // The evaluation's episode (eval/evaluation.cpp), ended hold_steps after the arrival.
-  agent::EpisodeOptions options;
-  options.goal_ned_m = episode.goal_ned_m;
-  options.beta_m = reach_radius_m;
-  options.start = episode.start;
-  options.reach_radius_m = reach_radius_m;
-  options.run_full_time = true;
-  options.steps_after_reach = config.hold_steps;
-  std::vector<agent::TrajectoryRow> trajectory;
-  options.trajectory = &trajectory;
-  std::unique_ptr<agent::VehicleLink> link = agent::make_in_process_link(plant);
-  const agent::EpisodeSummary summary = agent::run_episode(t, *link, controller, options);
+namespace {
 
-  const double dt = plant.control_step_s;
+/// One of the objective's episodes made ready to run (evaluation/evaluation.cpp's episode,
+/// ended hold_steps after the arrival): its plant, with the search's integration substeps, its
+/// task, options, vehicle and trajectory. Not movable: the options point to the trajectory.
+struct ObjectiveRun {
+  /// `buffer` becomes the trajectory (cleared; its capacity kept from earlier runs).
+  ObjectiveRun(const sim::VehicleModel& model, const task::TaskConfig& task,
+               const FinetuneEpisode& episode, const FinetuneConfig& config, double reach_radius_m,
+               std::vector<agent::TrajectoryRow>& buffer)
+      : plant(model), t(task), trajectory(buffer) {
+    if (config.integration_substeps > 0) plant.substeps = config.integration_substeps;
+    task::apply_vehicle(plant.facts(), t);
+    t.max_steps = episode.max_steps > 0 ? episode.max_steps : config.episode_steps;
+    if (episode.safety_radius_m > 0.0) t.beta_max_m = episode.safety_radius_m;
+    options.goal_ned_m = episode.goal_ned_m;
+    options.beta_m = reach_radius_m;
+    options.start = episode.start;
+    options.reach_radius_m = reach_radius_m;
+    options.run_full_time = true;
+    options.steps_after_reach = config.hold_steps;
+    trajectory.clear();
+    trajectory.reserve(static_cast<std::size_t>(t.max_steps));
+    options.trajectory = &trajectory;
+    link = agent::make_in_process_link(plant);
+  }
+  ObjectiveRun(const ObjectiveRun&) = delete;
+  ObjectiveRun& operator=(const ObjectiveRun&) = delete;
+
+  sim::VehicleModel plant;
+  task::TaskConfig t;
+  agent::EpisodeOptions options;
+  std::vector<agent::TrajectoryRow>& trajectory;
+  std::unique_ptr<agent::VehicleLink> link;
+};
+
+/// The prices of a run's episode from its trajectory and summary.
+ObjectiveTerms objective_terms(const ObjectiveRun& run, const agent::EpisodeSummary& summary,
+                               const FinetuneEpisode& episode, const FinetuneConfig& config,
+                               double reach_radius_m) {
+  const std::vector<agent::TrajectoryRow>& trajectory = run.trajectory;
+  const double dt = run.plant.control_step_s;
   ObjectiveTerms terms;
   double tilt_rad = 0.0;
   for (const agent::TrajectoryRow& row : trajectory) {
@@ -276,7 +294,7 @@ ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const tas
   double thrust_s = 0.0;
   if (config.energy_weight != 0.0 || config.smoothness_weight != 0.0) {
     const double smoothness =
-        eval::trajectory_smoothness(trajectory, 0, plant.thruster_dynamics.max_thrust_n);
+        eval::trajectory_smoothness(trajectory, 0, run.plant.thruster_dynamics.max_thrust_n);
     terms.energy_s = config.energy_weight * summary.thrust_energy;
     terms.smoothness_s = config.smoothness_weight * smoothness;
     thrust_s = config.energy_weight * summary.thrust_energy + config.smoothness_weight * smoothness;
@@ -318,11 +336,60 @@ ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const tas
     terms.objective_s = terms.arrival_s + terms.hold_s + terms.turn_s + margin_s + terms.lag_s;
     return terms;
   }
-  const double give_up_s = t.max_steps * dt;
+  const double give_up_s = run.t.max_steps * dt;
   terms.arrival_s = give_up_s + closest_m;
   terms.lag_s = lag_s(give_up_s);
   terms.objective_s = terms.arrival_s + margin_s + terms.lag_s;
   return terms;
+}
+
+}  // namespace
+
+ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                       agent::Controller& controller,
+                                       const FinetuneEpisode& episode, const FinetuneConfig& config,
+                                       double reach_radius_m) {
+  std::vector<agent::TrajectoryRow> trajectory;
+  ObjectiveRun run(model, task, episode, config, reach_radius_m, trajectory);
+  const agent::EpisodeSummary summary =
+      agent::run_episode(run.t, *run.link, controller, run.options);
+  return objective_terms(run, summary, episode, config, reach_radius_m);
+}
+
+BatchedObjective::BatchedObjective(const sim::VehicleModel& model, const task::TaskConfig& task,
+                                   const nn::Mlp& network, const FinetuneConfig& config,
+                                   std::size_t max_episodes)
+    : model_(model),
+      task_(task),
+      config_(config),
+      network_(network.spec(), static_cast<int>(std::max<std::size_t>(1, max_episodes))),
+      trajectories_(max_episodes) {
+  network_.copy_params_from(network);
+  const task::TaskConfig driving = finetune_driving_task(task);
+  for (std::size_t i = 0; i < max_episodes; ++i) aids_.emplace_back(network, driving);
+}
+
+std::vector<double> BatchedObjective::operator()(const std::vector<FinetuneEpisode>& episodes) {
+  if (episodes.size() > aids_.size()) {
+    throw std::invalid_argument("BatchedObjective: " + std::to_string(episodes.size()) +
+                                " episodes, more than the " + std::to_string(aids_.size()) +
+                                " it was made for");
+  }
+  std::vector<std::unique_ptr<ObjectiveRun>> runs;
+  std::vector<agent::PolicyEpisode> batch;
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    runs.push_back(
+        std::make_unique<ObjectiveRun>(model_, task_, episodes[i], config_, 0.5, trajectories_[i]));
+    ObjectiveRun& r = *runs.back();
+    batch.push_back({&r.t, r.link.get(), &aids_[i], &r.options});
+  }
+  const std::vector<agent::EpisodeSummary> summaries = agent::run_policy_episodes(network_, batch);
+  std::vector<double> objectives;
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    objectives.push_back(
+        objective_terms(*runs[i], summaries[i], episodes[i], config_, 0.5).objective_s);
+  }
+  return objectives;
 }
 
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,
@@ -378,6 +445,11 @@ task::TaskConfig finetune_driving_task(const task::TaskConfig& task) {
   return t;
 }
 
+int search_threads(const FinetuneConfig& config) {
+  return config.threads > 0 ? config.threads
+                            : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
+}
+
 FinetuneResult finetune_policy(
     const sim::VehicleModel& model, const task::TaskConfig& task, const nn::Mlp& start,
     const FinetuneConfig& config, std::uint64_t seed,
@@ -389,29 +461,40 @@ FinetuneResult finetune_policy(
   const std::vector<FinetuneEpisode> episodes = objective_episodes(model, task, config, seed);
   const auto t0 = std::chrono::steady_clock::now();
 
-  int threads = config.threads > 0 ? config.threads
-                                   : std::max(1, static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN)));
-  threads = std::min(threads, 2 * config.pairs);
-  std::vector<agent::PolicyController> workers;
-  for (int w = 0; w < threads; ++w) workers.emplace_back(start, finetune_driving_task(task));
-  nn::Mlp scratch = start;
-
-  // Mean objective of weights theta, with controller c (its network replaced).
-  auto objective = [&](agent::PolicyController& c, const Eigen::VectorXf& theta) {
-    scratch = c.network();
-    scratch.params() = theta;
-    c.set_network(scratch);
+  const int threads = std::min(search_threads(config), 2 * config.pairs);
+  // Per worker: the way-points driven all at once (BatchedObjective).
+  std::vector<BatchedObjective> batches;
+  for (int w = 0; w < threads; ++w) batches.emplace_back(model, task, start, config, episodes.size());
+  // The mean of per-episode objectives, summed in order.
+  const auto mean_of = [](const std::vector<double>& values) {
     double sum = 0.0;
-    for (const FinetuneEpisode& e : episodes) {
-      sum += arrival_objective(model, task, c, e, config);
-    }
-    return sum / static_cast<double>(episodes.size());
+    for (const double v : values) sum += v;
+    return sum / static_cast<double>(values.size());
+  };
+  // Mean objective of weights theta, its episodes split among the workers (each part's values in
+  // their own slots: the same sum whatever the threads).
+  const auto parts = static_cast<std::size_t>(threads);
+  std::vector<std::vector<FinetuneEpisode>> part_episodes(parts);
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    part_episodes[i * parts / episodes.size()].push_back(episodes[i]);
+  }
+  auto objective = [&](const Eigen::VectorXf& theta) {
+    std::vector<std::vector<double>> part_values(parts);
+    for_each_index(threads, parts, [&](int w, std::size_t part) {
+      BatchedObjective& batch = batches[static_cast<std::size_t>(w)];
+      batch.network().params() = theta;
+      part_values[part] = batch(part_episodes[part]);
+    });
+    std::vector<double> values;
+    for (const std::vector<double>& v : part_values) values.insert(values.end(), v.begin(), v.end());
+    return mean_of(values);
   };
 
+  nn::Mlp scratch = start;  // the weights shown to `progress`
   FinetuneResult result{start, 0.0, 0.0, 0, {}, episodes};
   Eigen::VectorXf theta = start.params();
   const Eigen::Index p = theta.size();
-  result.start_objective = objective(workers[0], theta);
+  result.start_objective = objective(theta);
   result.best_objective = result.start_objective;
   // Kingma & Ba's defaults (beta 0.9 / 0.999, epsilon 1e-8), no decay, no clipping.
   nn::AdamConfig adam_config;
@@ -429,27 +512,15 @@ FinetuneResult finetune_policy(
       eps.resize(p);
       nn::fill_standard_normal(rng, eps);
     }
-    // Sample s: pair s / 2, sign + for even s. Each worker takes every threads-th sample, so
-    // the values do not depend on the number of threads.
-    auto work = [&](int w) {
-      for (int s = w; s < samples; s += threads) {
-        const Eigen::VectorXf& eps = noise[static_cast<std::size_t>(s / 2)];
-        const float sign = s % 2 == 0 ? 1.0f : -1.0f;
-        agent::PolicyController& c = workers[static_cast<std::size_t>(w)];
-        nn::Mlp net = c.network();
-        net.params() = theta + sign * static_cast<float>(config.sigma) * eps;
-        c.set_network(std::move(net));
-        double sum = 0.0;
-        for (const FinetuneEpisode& e : episodes) {
-          sum += arrival_objective(model, task, c, e, config);
-        }
-        value[static_cast<std::size_t>(s)] = sum / static_cast<double>(episodes.size());
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int w = 1; w < threads; ++w) pool.emplace_back(work, w);
-    work(0);
-    for (std::thread& t : pool) t.join();
+    // Sample s: pair s / 2, sign + for even s; each value in its own slot, whichever worker
+    // runs it.
+    for_each_index(threads, static_cast<std::size_t>(samples), [&](int w, std::size_t s) {
+      const Eigen::VectorXf& eps = noise[s / 2];
+      const float sign = s % 2 == 0 ? 1.0f : -1.0f;
+      BatchedObjective& batch = batches[static_cast<std::size_t>(w)];
+      batch.network().params() = theta + sign * static_cast<float>(config.sigma) * eps;
+      value[s] = mean_of(batch(episodes));
+    });
 
     Eigen::VectorXf direction = rank_weighted_direction(value, noise, config.sigma);
     // The direction lowers the objective; Adam descends, so it steps on the negative.
@@ -458,7 +529,7 @@ FinetuneResult finetune_policy(
 
     FinetuneIteration stats;
     stats.iteration = it;
-    stats.objective = objective(workers[0], theta);
+    stats.objective = objective(theta);
     stats.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (stats.objective < result.best_objective) {
       result.best_objective = stats.objective;

@@ -25,6 +25,8 @@
 #include <limits>
 #include <vector>
 
+#include "agent/controller.hpp"
+#include "agent/episode.hpp"
 #include "common/nn/mlp.hpp"
 #include "common/task/task.hpp"
 #include "eval/evaluation.hpp"
@@ -195,6 +197,35 @@ ObjectiveTerms arrival_objective_terms(const sim::VehicleModel& model, const tas
                                        agent::Controller& controller,
                                        const FinetuneEpisode& episode, const FinetuneConfig& config,
                                        double reach_radius_m = 0.5);
+
+/// The threads a search (and its validations) runs on: config.threads, or one per CPU where 0.
+int search_threads(const FinetuneConfig& config);
+
+/// The objectives of way-points (arrival_objective(...) of each, reach radius 0.5 m) for one
+/// network driving them all at once, in lockstep through batched passes of the network
+/// (agent::run_policy_episodes), with the task's driving aids as the fine-tuning drives
+/// (finetune_driving_task): the same values as one way-point at a time, faster. Keeps its
+/// buffers from one call to the next. One per thread.
+class BatchedObjective {
+ public:
+  /// For up to max_episodes way-points at a time, starting with `network`'s weights.
+  BatchedObjective(const sim::VehicleModel& model, const task::TaskConfig& task,
+                   const nn::Mlp& network, const FinetuneConfig& config,
+                   std::size_t max_episodes);
+  /// The weights that drive (set its params()).
+  nn::Mlp& network() { return network_; }
+  /// Each way-point's objective, s, in order. Throws std::invalid_argument for more than
+  /// max_episodes.
+  std::vector<double> operator()(const std::vector<FinetuneEpisode>& episodes);
+
+ private:
+  const sim::VehicleModel& model_;
+  task::TaskConfig task_;
+  FinetuneConfig config_;
+  nn::Mlp network_;
+  std::vector<agent::PolicyController> aids_;  ///< per way-point: the driving aids' state
+  std::vector<std::vector<agent::TrajectoryRow>> trajectories_;
+};
 
 /// The objective of one way-point, s: arrival_objective_terms(...).objective_s.
 double arrival_objective(const sim::VehicleModel& model, const task::TaskConfig& task,

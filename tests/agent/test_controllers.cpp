@@ -6,10 +6,17 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <random>
+#include <set>
 #include <stdexcept>
 
 #include "agent/controller.hpp"
+#include "agent/episode.hpp"
+#include "agent/vehicle_link.hpp"
+#include "common/nn/file_io.hpp"
+#include "common/nn/gemm.hpp"
+#include "common/nn/serialize.hpp"
 #include "agent/pid_controller.hpp"
 #include "common/config/yaml_config.hpp"
 #include "common/nn/mlp.hpp"
@@ -162,6 +169,88 @@ TEST(PolicyController, ThePositionFilterShowsTheNetworkTheEstimatedPosition) {
     }
     EXPECT_LE((policy.goal_offset_ned_m() - expected_offset).norm(), 1e-12);
   }
+}
+
+// The fine-tuning drives its way-points in lockstep (run_policy_episodes): every summary and
+// trajectory must be the one the episode gives alone, with the driving aids, a dead thruster,
+// sensor noise and episodes that end at different steps.
+TEST(RunPolicyEpisodes, GiveEachEpisodeWhatItGivesAlone) {
+  if (!nn::gemm::uses_avx512()) {
+    GTEST_SKIP() << "the batched pass is bit-exact with the AVX-512 products only";
+  }
+  task::TaskConfig task;
+  task.layout = task::StateLayout::kExtendedThrust;
+  task::apply_vehicle(nessie().facts(), task);
+  task.max_steps = 120;
+  ASSERT_TRUE(task.position_filter.enabled());
+  ASSERT_TRUE(task.integral.enabled());
+  // The committed policy, which reaches its way-points: the episodes end at their own steps.
+  const nn::Mlp committed = nn::network_from_bytes(
+      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  nn::Mlp network(committed.spec(), 5);
+  network.copy_params_from(committed);
+  std::vector<EpisodeOptions> options(5);
+  for (std::size_t i = 0; i < options.size(); ++i) {
+    EpisodeOptions& o = options[i];
+    o.goal_ned_m = Eigen::Vector3d(1.0 + static_cast<double>(i), -2.0, 5.5);
+    o.start.euler_rpy_rad[2] = 0.7 * static_cast<double>(i);
+    o.start.seed = 11 + i;
+    o.run_full_time = true;
+    o.steps_after_reach = static_cast<int>(10 * i);
+  }
+  options[1].start.thruster_efficiency = {1.0, 0.0, 1.0, 1.0, 1.0, 1.0};
+  options[2].start.sensor_noise.position_sigma_m = 0.1;
+  options[3].start.position_ned_m = Eigen::Vector3d(1.0, 0.0, 5.0);
+
+  std::vector<std::unique_ptr<VehicleLink>> links;
+  std::vector<PolicyController> aids;
+  std::vector<std::vector<TrajectoryRow>> together(options.size()), alone(options.size());
+  std::vector<PolicyEpisode> episodes;
+  for (std::size_t i = 0; i < options.size(); ++i) {
+    links.push_back(make_in_process_link(nessie()));
+    aids.emplace_back(network, task);
+  }
+  for (std::size_t i = 0; i < options.size(); ++i) {
+    options[i].trajectory = &together[i];
+    episodes.push_back({&task, links[i].get(), &aids[i], &options[i]});
+  }
+  const std::vector<EpisodeSummary> summaries = run_policy_episodes(network, episodes);
+  ASSERT_EQ(summaries.size(), options.size());
+  std::set<int> lengths;
+  for (std::size_t i = 0; i < options.size(); ++i) {
+    PolicyController policy(network, task);
+    EpisodeOptions o = options[i];
+    o.trajectory = &alone[i];
+    const EpisodeSummary one = run_episode(task, *links[i], policy, o);
+    const EpisodeSummary& s = summaries[i];
+    lengths.insert(s.length_steps);
+    EXPECT_EQ(s.length_steps, one.length_steps) << i;
+    EXPECT_EQ(s.end_reason, one.end_reason) << i;
+    EXPECT_EQ(s.time_to_reach_s, one.time_to_reach_s) << i;
+    EXPECT_EQ(s.thrust_energy, one.thrust_energy) << i;
+    EXPECT_EQ(s.final_distance_m, one.final_distance_m) << i;
+    EXPECT_EQ(s.mean_error_after_reach_m, one.mean_error_after_reach_m) << i;
+    EXPECT_EQ(s.episode_return, one.episode_return) << i;
+    ASSERT_EQ(together[i].size(), alone[i].size()) << i;
+    for (std::size_t k = 0; k < alone[i].size(); ++k) {
+      ASSERT_EQ(together[i][k].thrust_command_n, alone[i][k].thrust_command_n) << i << " " << k;
+      ASSERT_EQ(together[i][k].distance_m, alone[i][k].distance_m) << i << " " << k;
+    }
+  }
+  EXPECT_GE(lengths.size(), 4u) << "the episodes should end at different steps";
+}
+
+TEST(RunPolicyEpisodes, RefusesMoreEpisodesThanTheNetworksBatch) {
+  task::TaskConfig task;
+  task::apply_vehicle(nessie().facts(), task);
+  nn::Mlp network = actor(task.state_dim(), 6);  // a batch of 1
+  std::unique_ptr<VehicleLink> a = make_in_process_link(nessie());
+  std::unique_ptr<VehicleLink> b = make_in_process_link(nessie());
+  PolicyController pa(network, task), pb(network, task);
+  const EpisodeOptions options;
+  EXPECT_THROW(run_policy_episodes(network, {{&task, a.get(), &pa, &options},
+                                             {&task, b.get(), &pb, &options}}),
+               std::invalid_argument);
 }
 
 TEST(PidController, PseudoInverseReproducesTheFiveControllableDof) {

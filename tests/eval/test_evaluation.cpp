@@ -17,6 +17,7 @@
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "eval/evaluation.hpp"
+#include "eval/quick_evaluator.hpp"
 #include "eval/ranking.hpp"
 
 namespace auvrl::eval {
@@ -259,6 +260,27 @@ TEST(ValidationScore, RowsThatAreNotTheReferencesEpisodesAreAnError) {
     FAIL() << "a different way-point was scored";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("episode 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST(QuickEvaluator, ScoresTheSameOnAnyNumberOfThreads) {
+  task::TaskConfig task;
+  task.layout = task::StateLayout::kExtendedThrust;
+  task::apply_vehicle(nessie().facts(), task);
+  const nn::Mlp policy = nn::network_from_bytes(
+      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  const QuickEvaluator quick(nessie(), task, 4, 2);
+  const ValidationScore one = quick.evaluate(policy);
+  EXPECT_EQ(one.episodes, 6);
+  for (const int threads : {2, 3}) {
+    const ValidationScore many = quick.evaluate(policy, threads);
+    EXPECT_EQ(many.reached, one.reached) << threads;
+    EXPECT_EQ(many.episodes, one.episodes) << threads;
+    EXPECT_EQ(many.mean_time_s, one.mean_time_s) << threads;
+    EXPECT_EQ(many.mean_hold_m, one.mean_hold_m) << threads;
+    EXPECT_EQ(many.max_time_ratio, one.max_time_ratio) << threads;
+    EXPECT_EQ(many.mean_energy, one.mean_energy) << threads;
+    EXPECT_EQ(many.mean_smoothness, one.mean_smoothness) << threads;
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -284,6 +285,22 @@ TEST(Smoothness, MeanAbsoluteChangePerStepAndThrusterFromZero) {
   std::vector<std::vector<double>> bang;
   for (int t = 0; t < 100; ++t) bang.push_back({t % 2 ? -1.0 : 1.0});
   EXPECT_NEAR(command_smoothness(bang), (1.0 + 99 * 2.0) / 100.0, 1e-12);
+}
+
+TEST(Smoothness, OfATrajectoryIsThatOfItsNormalisedCommands) {
+  std::vector<agent::TrajectoryRow> rows(40);
+  std::vector<std::vector<double>> normalised;
+  for (std::size_t t = 0; t < rows.size(); ++t) {
+    for (int i = 0; i < 6; ++i) {
+      rows[t].thrust_command_n.push_back(std::sin(0.7 * static_cast<double>(t) + i) * 13.3);
+    }
+    if (t < 5) continue;  // from row 5 on
+    std::vector<double> u = rows[t].thrust_command_n;
+    for (double& f : u) f /= 20.0;
+    normalised.push_back(u);
+  }
+  EXPECT_EQ(trajectory_smoothness(rows, 5, 20.0), command_smoothness(normalised));
+  EXPECT_EQ(trajectory_smoothness(rows, 40, 20.0), 0.0);
 }
 
 SummaryRow row(const std::string& group, double time_s, double hold_m, double final_m,
@@ -660,11 +677,19 @@ TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {
   EXPECT_TRUE(std::isfinite(a.groups[0].mean_time_s));
   EXPECT_TRUE(std::isfinite(a.groups[0].mean_hold_m));
 
-  // Deterministic: the same figures again.
+  // Deterministic: the same figures again, and on three threads with a PID each.
   const RobustnessResult b = run_robustness(nessie(), config(), pid, 2, 1, "");
+  const RobustnessResult c = run_robustness(
+      nessie(), config(), [] { return std::make_unique<agent::PidController>(nessie()); }, 3, 2,
+      1, "");
+  ASSERT_EQ(c.rows.size(), a.rows.size());
   for (std::size_t i = 0; i < a.rows.size(); ++i) {
-    EXPECT_EQ(a.rows[i].final_error_m, b.rows[i].final_error_m) << i;
-    EXPECT_EQ(a.rows[i].smoothness, b.rows[i].smoothness) << i;
+    for (const RobustnessResult* r : {&b, &c}) {
+      EXPECT_EQ(a.rows[i].final_error_m, r->rows[i].final_error_m) << i;
+      EXPECT_EQ(a.rows[i].time_to_reach_s, r->rows[i].time_to_reach_s) << i;
+      EXPECT_EQ(a.rows[i].thrust_energy, r->rows[i].thrust_energy) << i;
+      EXPECT_EQ(a.rows[i].smoothness, r->rows[i].smoothness) << i;
+    }
   }
 
   const auto groups = read_csv(dir.path("out/robustness.csv"));

@@ -308,42 +308,35 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
   EXPECT_FALSE(no_further_candidate(config, true, 47, 17, 1));
   config.candidates_within_s = 0;
   EXPECT_FALSE(no_further_candidate(config, false, 470, 170, 1));
-  // Nor one that would end past the searches' own cap, counted from the first one's start.
+  // The searches' cap is each search's own (search_past_cap): it stops none from starting.
   config.max_search_s = 20;
-  EXPECT_FALSE(no_further_candidate(config, false, 30, 9, 1));
-  const auto past_cap = no_further_candidate(config, false, 30, 11, 1);
-  ASSERT_TRUE(past_cap);
-  EXPECT_NE(past_cap->find("22.0 s of searching, past finetune.max_search_s (20 s)"),
-            std::string::npos)
-      << *past_cap;
-  EXPECT_FALSE(no_further_candidate(config, true, 30, 11, 1));
+  EXPECT_FALSE(no_further_candidate(config, false, 30, 15, 1));
 }
 
 // An asynchronous run's search ends once its next iteration, at the mean pace of those done,
-// would end past finetune.max_search_s of searching; never a reproducible run's, nor after its
+// would end past finetune.max_search_s of that search; never a reproducible run's, nor after its
 // last iteration, nor without a cap.
 TEST(MaxSearchTest, ASearchEndsWhenItsNextIterationWouldEndPastTheCap) {
   tuning::FinetuneConfig config;
   config.iterations = 72;
   config.max_search_s = 20;
-  // 10 s of searching, 40 iterations in 10 s: the next would end at 10.25 s.
-  EXPECT_FALSE(search_past_cap(config, false, 10, 10, 40));
-  // The second search 4 s in, after 15 s of the first: 20 iterations in 4 s, the next at 19.2 s.
-  EXPECT_FALSE(search_past_cap(config, false, 19, 4, 20));
-  // 19.9 s, 60 iterations in 15 s: 20.15 s.
-  const auto why = search_past_cap(config, false, 19.9, 15, 60);
+  // 40 iterations in 10 s: the next would end at 10.25 s.
+  EXPECT_FALSE(search_past_cap(config, false, 10, 40));
+  // 60 iterations in 19.8 s: 20.13 s.
+  const auto why = search_past_cap(config, false, 19.8, 60);
   ASSERT_TRUE(why);
-  EXPECT_NE(why->find("ended after iteration 60 of 72"), std::string::npos) << *why;
+  EXPECT_NE(why->find("ended after iteration 60 of 72 at 19.8 s"), std::string::npos) << *why;
   EXPECT_NE(why->find("finetune.max_search_s (20 s)"), std::string::npos) << *why;
-  EXPECT_FALSE(search_past_cap(config, true, 19.9, 15, 60));
-  EXPECT_FALSE(search_past_cap(config, false, 100, 15, 72));
-  EXPECT_FALSE(search_past_cap(config, false, 100, 15, 0));
+  EXPECT_FALSE(search_past_cap(config, true, 19.8, 60));
+  EXPECT_FALSE(search_past_cap(config, false, 100, 72));
+  EXPECT_FALSE(search_past_cap(config, false, 100, 0));
   config.max_search_s = 0;
-  EXPECT_FALSE(search_past_cap(config, false, 560, 150, 60));
+  EXPECT_FALSE(search_past_cap(config, false, 560, 60));
 }
 
 // A search cut short by finetune.max_search_s validates the iteration it ends at and keeps the
-// best validated weights, as at its last iteration, and no further candidate starts.
+// best validated weights, as at its last iteration; the cap is each search's, and the next
+// candidate is cut short the same way.
 TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   RefinetuneOptions o = refinetune_committed_policy(tmp, 5, 2);
@@ -358,13 +351,16 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   o.config_path = config.string();
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
-  EXPECT_NE(out.str().find("ended after iteration 1 of 5"), std::string::npos) << out.str();
-  EXPECT_NE(out.str().find("1 of 2 candidates searched"), std::string::npos) << out.str();
-  const auto rows = test_support::read_csv(tmp / "again" / "finetune.csv");
-  ASSERT_EQ(rows.size(), 1u) << out.str();
-  EXPECT_EQ(rows[0].at("iteration"), "1");
-  EXPECT_FALSE(rows[0].at("validation_reached").empty());
-  EXPECT_FALSE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
+  EXPECT_NE(out.str().find("candidate 1/2: ended after iteration 1 of 5"), std::string::npos)
+      << out.str();
+  EXPECT_NE(out.str().find("candidate 2/2: ended after iteration 1 of 5"), std::string::npos)
+      << out.str();
+  for (const char* file : {"finetune.csv", "finetune_candidate2.csv"}) {
+    const auto rows = test_support::read_csv(tmp / "again" / file);
+    ASSERT_EQ(rows.size(), 1u) << file << "\n" << out.str();
+    EXPECT_EQ(rows[0].at("iteration"), "1");
+    EXPECT_FALSE(rows[0].at("validation_reached").empty());
+  }
   const std::string evaluated = evaluated_policy(tmp / "again");
   EXPECT_TRUE(evaluated == policy || evaluated == o.out_dir + "/policy_finetuned.nn") << evaluated;
 }

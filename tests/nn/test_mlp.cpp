@@ -206,6 +206,31 @@ TEST(Mlp, BatchedForwardEqualsOneSampleAtATime) {
   }
 }
 
+// The fine-tuning runs its episodes in lockstep through one batched pass (agent::
+// run_policy_episodes) and must give the bytes of one episode at a time: an actor's columns do
+// not depend on the batch around them (each entry sums its products in the same order, and the
+// output's tanh is the same function on every entry).
+TEST(Mlp, ActorColumnsOfABatchHaveTheBytesOfOneSampleAtATime) {
+  Rng rng(5);
+  Mlp batched(MlpSpec::actor(23, {64, 64}, 6), 42);
+  batched.init_lillicrap(rng);
+  batched.weight(2) *= 200.0f;  // outputs spread over (-1, 1), not all near 0 or saturated
+  Mlp single(batched.spec(), 1);
+  single.copy_params_from(batched);
+  const Matrix x = 3.0f * random_matrix(rng, 23, 42);
+  for (const int n : {42, 41, 7, 6, 5, 1}) {
+    const Matrix out = batched.forward(x.leftCols(n));
+    EXPECT_GT(out.cwiseAbs().maxCoeff(), 0.5f);
+    EXPECT_LT(out.cwiseAbs().maxCoeff(), 0.9999f);
+    for (int j = 0; j < n; ++j) {
+      const Matrix one = single.forward(x.col(j));
+      for (int i = 0; i < 6; ++i) {
+        ASSERT_EQ(one(i, 0), out(i, j)) << "batch " << n << ", column " << j << ", output " << i;
+      }
+    }
+  }
+}
+
 TEST(Mlp, WrongShapesAreRejected) {
   Mlp actor(MlpSpec::actor(3, {8}, 2), 4);
   EXPECT_THROW(actor.forward(Matrix::Zero(4, 2)), std::invalid_argument);

@@ -16,6 +16,7 @@
 
 #include "agent/pid_controller.hpp"
 #include "agent_test_util.hpp"
+#include "common/nn/gemm.hpp"
 #include "common/nn/random.hpp"
 #include "tuning/policy_finetune.hpp"
 #include "tuning_test_util.hpp"
@@ -603,6 +604,42 @@ nn::Mlp detuned_policy() {
     policy.params()[i] += 0.05f * static_cast<float>(nn::standard_normal(rng));
   }
   return policy;
+}
+
+// The search scores its way-points all at once (BatchedObjective): each must get the objective
+// of its own episode, to the bit, with dead thrusters, noise, starts anywhere and turned ones,
+// and again with other weights on the buffers the first call left.
+TEST(BatchedObjective, GivesEachWayPointTheObjectiveOfItsOwnEpisode) {
+  if (!nn::gemm::uses_avx512()) {
+    GTEST_SKIP() << "the batched pass is bit-exact with the AVX-512 products only";
+  }
+  FinetuneConfig c;
+  c.episodes = 10;
+  c.randomised_fraction = 0.4;
+  c.noisy_fraction = 0.2;
+  c.any_start_fraction = 0.2;
+  c.random_heading_fraction = 0.3;
+  c.randomised_episode_steps = 300;
+  c.integration_substeps = 2;
+  c.energy_weight = 0.1;
+  c.smoothness_weight = 100;
+  c.hold_turn_weight = 20;
+  const std::vector<FinetuneEpisode> episodes = finetune_episodes(fast_task(), c, 4);
+  BatchedObjective batch(nessie(), fast_task(), detuned_policy(), c, episodes.size());
+  agent::PolicyController alone(detuned_policy(), finetune_driving_task(fast_task()));
+  for (int round = 0; round < 2; ++round) {
+    const std::vector<double> together = batch(episodes);
+    ASSERT_EQ(together.size(), episodes.size());
+    for (std::size_t i = 0; i < episodes.size(); ++i) {
+      EXPECT_EQ(together[i], arrival_objective(nessie(), fast_task(), alone, episodes[i], c))
+          << "round " << round << ", way-point " << i;
+    }
+    batch.network().params() = committed_policy().params();
+    alone.set_network(committed_policy());
+  }
+  std::vector<FinetuneEpisode> more = episodes;
+  more.push_back(episodes.front());
+  EXPECT_THROW(batch(more), std::invalid_argument);
 }
 
 TEST(FinetunePolicy, LowersTheObjectiveOfATrainedPolicy) {
