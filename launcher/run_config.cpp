@@ -107,7 +107,7 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "an asynchronous run starts a further candidate only if it would end within this "
           "many seconds of the training's start, at the pace of those before");
   t.field("max_search_s", &C::max_search_s, "s, 0: no cap",
-          "an asynchronous run's searches' wall-clock cap from the first one's start: a search "
+          "an asynchronous run's wall-clock cap on each search, from its own start: a search "
           "ends once its next iteration would end past it, keeping the best validated weights");
   t.field("selection_seed", &C::selection_seed, "not 1",
           "the robustness suite's draw that chooses among the candidates, and on which the "

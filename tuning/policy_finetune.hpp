@@ -131,13 +131,13 @@ struct FinetuneConfig {
   /// or `auvrl finetune`'s start; s; 0: no limit), so that a slower machine keeps the training's
   /// minute with fewer candidates. A reproducible run searches them all.
   double candidates_within_s = 0.0;
-  /// The searches' wall-clock cap in an asynchronous run, from the first search's start (s; 0:
-  /// no cap): a search ends early once, at the mean pace of its iterations so far, the next
-  /// would end past it; the iteration it ends at is validated, and the best validated weights
-  /// so far are kept. No further candidate starts that would end past it. With the TD3 phase's
-  /// own cap (run.max_train_s) it bounds the whole training, so that a slower or busy machine
-  /// keeps the training's minute with a shorter search; a longer TD3 phase asked for
-  /// (`--max-seconds`) leaves the searches their time. A reproducible run runs every iteration.
+  /// An asynchronous run's wall-clock cap on each search, from that search's start (s; 0: no
+  /// cap): a search ends early once, at the mean pace of its iterations so far, the next would
+  /// end past it; the iteration it ends at is validated, and the best validated weights so far
+  /// are kept. With the TD3 phase's own cap (run.max_train_s) it bounds the training, so that a
+  /// slower or busy machine keeps the training's minute with a shorter search (a further one
+  /// starts only within candidates_within_s); a longer TD3 phase asked for (`--max-seconds`)
+  /// leaves the searches their time. A reproducible run runs every iteration.
   double max_search_s = 0.0;
   /// The robustness suite's draw that chooses among the candidates, and on which the pipeline's
   /// select stage counts the trained policies' flips: a validation draw of its own, never the
