@@ -122,8 +122,8 @@ EpisodeStepper::EpisodeStepper(const task::TaskConfig& task, VehicleLink& link,
     : task_(task),
       link_(link),
       options_(options),
-      figures_(std::make_unique<EpisodeFigures>(summary_, options.reach_radius_m,
-                                                task.control_step_s)) {
+      figures_(
+          std::make_unique<EpisodeFigures>(summary_, options.reach_radius_m, task.control_step_s)) {
   const int n = link.num_thrusters();
   if (n != task.num_thrusters) {
     throw std::invalid_argument("the vehicle has " + std::to_string(n) +
@@ -190,7 +190,7 @@ void EpisodeStepper::step() {
 
   if (!task_ended_) {
     if (options.on_transition) {
-      Transition tr{state_,      action_,           outcome.reward,
+      Transition tr{state_,      action_,          outcome.reward,
                     next_state_, outcome.terminal, next->observation.position_ned_m,
                     t - 1,       expert_action_};
       options.on_transition(tr);
@@ -240,6 +240,13 @@ std::vector<EpisodeSummary> run_policy_episodes(nn::Mlp& network,
     throw std::invalid_argument("run_policy_episodes: " + std::to_string(count) +
                                 " episodes, more than the network's batch of " +
                                 std::to_string(network.max_batch()));
+  }
+  for (const PolicyEpisode& e : episodes) {
+    const nn::MlpSpec& own = e.controller->network().spec();
+    if (own.input_dim != network.spec().input_dim || own.output_dim != network.spec().output_dim) {
+      throw std::invalid_argument("run_policy_episodes: the network (" + network.spec().describe() +
+                                  ") does not fit a controller's (" + own.describe() + ")");
+    }
   }
   std::vector<std::unique_ptr<EpisodeStepper>> steppers;
   steppers.reserve(episodes.size());

@@ -164,7 +164,7 @@ struct PolicyEpisode {
 /// the episodes still running: the summaries (and trajectories and transitions) run_episode
 /// gives each with its controller driving `network`, to the bit where the network's columns
 /// are computed as one sample is (nn::Mlp on AVX-512). Throws std::invalid_argument for more
-/// episodes than network.max_batch().
+/// episodes than network.max_batch(), or a network whose sizes are not the controllers'.
 std::vector<EpisodeSummary> run_policy_episodes(nn::Mlp& network,
                                                 const std::vector<PolicyEpisode>& episodes);
 

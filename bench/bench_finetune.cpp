@@ -23,12 +23,12 @@ using namespace auvrl;
 
 /// The fast preset's model, task, fine-tuning and way-points, and the committed policy.
 struct Setup {
-  launcher::RunConfig config = launcher::read_run_config(std::string(AUVRL_CONFIG_DIR) +
-                                                         "/presets/fast.yaml");
+  launcher::RunConfig config =
+      launcher::read_run_config(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
   sim::VehicleModel model = sim::load_vehicle_file(config.vehicle_path);
   task::TaskConfig task = applied(config.task, model);
-  nn::Mlp policy = nn::network_from_bytes(
-      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  nn::Mlp policy =
+      nn::network_from_bytes(nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
   std::vector<tuning::FinetuneEpisode> episodes =
       tuning::objective_episodes(model, task, config.finetune, 1);
 

@@ -20,8 +20,8 @@ namespace auvrl {
 template <typename Work>
 void for_each_index(int threads, std::size_t count, Work&& work) {
   if (count == 0) return;
-  const int used = static_cast<int>(std::min<std::size_t>(
-      static_cast<std::size_t>(std::max(1, threads)), count));
+  const int used = static_cast<int>(
+      std::min<std::size_t>(static_cast<std::size_t>(std::max(1, threads)), count));
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::exception_ptr error;

@@ -40,9 +40,8 @@ ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network, int threads) co
   for (int w = 0; w < used; ++w) controllers.emplace_back(network, task_);
   std::vector<SummaryRow> rows(episodes_.size());
   for_each_index(used, episodes_.size(), [&](int w, std::size_t i) {
-    rows[i] = run_evaluation_episode(model_, config_,
-                                     controllers[static_cast<std::size_t>(w)], episodes_[i],
-                                     nullptr);
+    rows[i] = run_evaluation_episode(model_, config_, controllers[static_cast<std::size_t>(w)],
+                                     episodes_[i], nullptr);
   });
   return score_against_reference(rows, reference_);
 }

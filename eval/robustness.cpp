@@ -545,8 +545,7 @@ EvaluationConfig drawn_episodes_config(const sim::VehicleModel& model, Evaluatio
 RobustnessResult run_robustness_with(
     const sim::VehicleModel& model, const EvaluationConfig& config, int episodes_per_group,
     std::uint64_t seed, const std::string& out_dir,
-    const std::function<std::vector<SummaryRow>(const std::vector<EvaluationEpisode>&)>&
-        run_rows) {
+    const std::function<std::vector<SummaryRow>(const std::vector<EvaluationEpisode>&)>& run_rows) {
   if (!out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
@@ -613,11 +612,11 @@ RobustnessResult run_robustness(const sim::VehicleModel& model, EvaluationConfig
                                 const ControllerFactory& make_controller, int threads,
                                 int episodes_per_group, std::uint64_t seed,
                                 const std::string& out_dir) {
-  return run_robustness_with(
-      model, config, episodes_per_group, seed, out_dir,
-      [&](const std::vector<EvaluationEpisode>& episodes) {
-        return run_drawn_episodes(model, config, make_controller, episodes, threads);
-      });
+  return run_robustness_with(model, config, episodes_per_group, seed, out_dir,
+                             [&](const std::vector<EvaluationEpisode>& episodes) {
+                               return run_drawn_episodes(model, config, make_controller, episodes,
+                                                         threads);
+                             });
 }
 
 namespace {

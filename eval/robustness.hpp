@@ -54,9 +54,9 @@
 
 #include <cstdint>
 #include <functional>
-#include <memory>
 #include <iosfwd>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 

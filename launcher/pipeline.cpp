@@ -207,7 +207,8 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
       nn::save_network_file((iterates / fmt::format("iteration_{:03d}.nn", it.iteration)).string(),
                             weights);
     }
-    const eval::ValidationScore score = in.validation.evaluate(weights, tuning::search_threads(in.config));
+    const eval::ValidationScore score =
+        in.validation.evaluate(weights, tuning::search_threads(in.config));
     csv.add(it.iteration, it.objective, it.elapsed_s, &score);
     if (eval::ranks_above(score, best.score, ranking)) best = {score, weights, it.iteration};
     out << fmt::format(
@@ -302,7 +303,8 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
       "way-points{})\n",
       start_path, in.config.iterations, 2 * in.config.pairs, in.config.episodes,
       in.config.candidates == 1 ? "" : fmt::format("; {} candidates", in.config.candidates));
-  const eval::ValidationScore before = in.validation.evaluate(start, tuning::search_threads(in.config));
+  const eval::ValidationScore before =
+      in.validation.evaluate(start, tuning::search_threads(in.config));
   const CandidateSearch search = search_candidates(in, start, before, out);
   const FinetuneBest& best = search.best;
   out << fmt::format("auvrl train: fine-tuned: objective {:.3f} -> {:.3f} s\n",

@@ -95,10 +95,10 @@ int SuiteSelector::groups_passing(const nn::Mlp& policy) const {
 CandidateScore SuiteSelector::score(const nn::Mlp& policy) const {
   CandidateScore s;
   s.groups_passing = groups_passing(policy);
-  s.behind_late = late_arrivals(
-      eval::run_drawn_episodes(model_, suite_config(task_, seed_),
-                               policy_controllers(policy, task_), behind_, threads_),
-      pid_behind_);
+  s.behind_late =
+      late_arrivals(eval::run_drawn_episodes(model_, suite_config(task_, seed_),
+                                             policy_controllers(policy, task_), behind_, threads_),
+                    pid_behind_);
   s.behind_episodes = static_cast<int>(behind_.size());
   return s;
 }

@@ -464,7 +464,8 @@ FinetuneResult finetune_policy(
   const int threads = std::min(search_threads(config), 2 * config.pairs);
   // Per worker: the way-points driven all at once (BatchedObjective).
   std::vector<BatchedObjective> batches;
-  for (int w = 0; w < threads; ++w) batches.emplace_back(model, task, start, config, episodes.size());
+  for (int w = 0; w < threads; ++w)
+    batches.emplace_back(model, task, start, config, episodes.size());
   // The mean of per-episode objectives, summed in order.
   const auto mean_of = [](const std::vector<double>& values) {
     double sum = 0.0;
@@ -486,7 +487,8 @@ FinetuneResult finetune_policy(
       part_values[part] = batch(part_episodes[part]);
     });
     std::vector<double> values;
-    for (const std::vector<double>& v : part_values) values.insert(values.end(), v.begin(), v.end());
+    for (const std::vector<double>& v : part_values)
+      values.insert(values.end(), v.begin(), v.end());
     return mean_of(values);
   };
 

@@ -210,8 +210,7 @@ class BatchedObjective {
  public:
   /// For up to max_episodes way-points at a time, starting with `network`'s weights.
   BatchedObjective(const sim::VehicleModel& model, const task::TaskConfig& task,
-                   const nn::Mlp& network, const FinetuneConfig& config,
-                   std::size_t max_episodes);
+                   const nn::Mlp& network, const FinetuneConfig& config, std::size_t max_episodes);
   /// The weights that drive (set its params()).
   nn::Mlp& network() { return network_; }
   /// Each way-point's objective, s, in order. Throws std::invalid_argument for more than

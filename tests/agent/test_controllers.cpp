@@ -13,13 +13,13 @@
 
 #include "agent/controller.hpp"
 #include "agent/episode.hpp"
+#include "agent/pid_controller.hpp"
 #include "agent/vehicle_link.hpp"
+#include "common/config/yaml_config.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/gemm.hpp"
-#include "common/nn/serialize.hpp"
-#include "agent/pid_controller.hpp"
-#include "common/config/yaml_config.hpp"
 #include "common/nn/mlp.hpp"
+#include "common/nn/serialize.hpp"
 #include "eval/evaluation.hpp"
 #include "sim/vehicle_model.hpp"
 
@@ -185,8 +185,8 @@ TEST(RunPolicyEpisodes, GiveEachEpisodeWhatItGivesAlone) {
   ASSERT_TRUE(task.position_filter.enabled());
   ASSERT_TRUE(task.integral.enabled());
   // The committed policy, which reaches its way-points: the episodes end at their own steps.
-  const nn::Mlp committed = nn::network_from_bytes(
-      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  const nn::Mlp committed =
+      nn::network_from_bytes(nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
   nn::Mlp network(committed.spec(), 5);
   network.copy_params_from(committed);
   std::vector<EpisodeOptions> options(5);
@@ -240,7 +240,7 @@ TEST(RunPolicyEpisodes, GiveEachEpisodeWhatItGivesAlone) {
   EXPECT_GE(lengths.size(), 4u) << "the episodes should end at different steps";
 }
 
-TEST(RunPolicyEpisodes, RefusesMoreEpisodesThanTheNetworksBatch) {
+TEST(RunPolicyEpisodes, RefusesMoreEpisodesThanTheNetworksBatchOrANetworkThatDoesNotFit) {
   task::TaskConfig task;
   task::apply_vehicle(nessie().facts(), task);
   nn::Mlp network = actor(task.state_dim(), 6);  // a batch of 1
@@ -248,8 +248,11 @@ TEST(RunPolicyEpisodes, RefusesMoreEpisodesThanTheNetworksBatch) {
   std::unique_ptr<VehicleLink> b = make_in_process_link(nessie());
   PolicyController pa(network, task), pb(network, task);
   const EpisodeOptions options;
-  EXPECT_THROW(run_policy_episodes(network, {{&task, a.get(), &pa, &options},
-                                             {&task, b.get(), &pb, &options}}),
+  EXPECT_THROW(run_policy_episodes(
+                   network, {{&task, a.get(), &pa, &options}, {&task, b.get(), &pb, &options}}),
+               std::invalid_argument);
+  nn::Mlp wider(nn::MlpSpec::actor(task.state_dim() + 1, {16, 16}, 6), 2);
+  EXPECT_THROW(run_policy_episodes(wider, {{&task, a.get(), &pa, &options}}),
                std::invalid_argument);
 }
 

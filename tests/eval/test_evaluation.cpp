@@ -267,8 +267,8 @@ TEST(QuickEvaluator, ScoresTheSameOnAnyNumberOfThreads) {
   task::TaskConfig task;
   task.layout = task::StateLayout::kExtendedThrust;
   task::apply_vehicle(nessie().facts(), task);
-  const nn::Mlp policy = nn::network_from_bytes(
-      nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
+  const nn::Mlp policy =
+      nn::network_from_bytes(nn::read_file(std::string(AUVRL_CONFIG_DIR) + "/policies/fast.nn"), 1);
   const QuickEvaluator quick(nessie(), task, 4, 2);
   const ValidationScore one = quick.evaluate(policy);
   EXPECT_EQ(one.episodes, 6);

@@ -680,8 +680,8 @@ TEST(RobustnessRun, ThePidOnTwoEpisodesPerGroupWritesFiniteFigures) {
   // Deterministic: the same figures again, and on three threads with a PID each.
   const RobustnessResult b = run_robustness(nessie(), config(), pid, 2, 1, "");
   const RobustnessResult c = run_robustness(
-      nessie(), config(), [] { return std::make_unique<agent::PidController>(nessie()); }, 3, 2,
-      1, "");
+      nessie(), config(), [] { return std::make_unique<agent::PidController>(nessie()); }, 3, 2, 1,
+      "");
   ASSERT_EQ(c.rows.size(), a.rows.size());
   for (std::size_t i = 0; i < a.rows.size(); ++i) {
     for (const RobustnessResult* r : {&b, &c}) {
