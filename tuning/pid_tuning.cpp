@@ -9,10 +9,10 @@
 #include <map>
 #include <ostream>
 #include <stdexcept>
-#include <thread>
 
 #include "agent/pid_controller.hpp"
 #include "common/config/table.hpp"
+#include "common/parallel.hpp"
 #include "common/random.hpp"
 
 namespace auvrl::tuning {
@@ -181,18 +181,13 @@ PidObjective pid_objective(const sim::VehicleModel& model, const task::TaskConfi
   agent::check_pid_gains(gains);
   const int threads = thread_count(config, episodes.size());
   std::vector<eval::SummaryRow> rows(episodes.size());
-  // Worker w runs episodes w, w + threads, ...: each row is its episode's, whatever the timing.
-  auto work = [&](int w) {
-    agent::PidController pid(model, gains);
-    for (std::size_t i = static_cast<std::size_t>(w); i < episodes.size();
-         i += static_cast<std::size_t>(threads)) {
-      rows[i] = eval::run_evaluation_episode(model, c, pid, episodes[i], nullptr);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < threads; ++w) pool.emplace_back(work, w);
-  work(0);
-  for (std::thread& t : pool) t.join();
+  // A PID per thread; each row is its episode's, whatever the timing.
+  std::vector<agent::PidController> pids;
+  for (int w = 0; w < threads; ++w) pids.emplace_back(model, gains);
+  for_each_index(threads, episodes.size(), [&](int w, std::size_t i) {
+    rows[i] = eval::run_evaluation_episode(model, c, pids[static_cast<std::size_t>(w)], episodes[i],
+                                           nullptr);
+  });
   return score(rows, config, config.episode_steps * model.control_step_s);
 }
 
