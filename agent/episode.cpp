@@ -95,6 +95,13 @@ bool usable(const VehicleReport& r) {
          o.velocity_body_mps.allFinite() && o.angular_rate_body_rad_s.allFinite();
 }
 
+/// Why a report ends the episode: none from the vehicle (kSimTimeout), or one the task cannot
+/// use (kBlowUp); kNone when it is usable.
+task::EndReason unusable_reason(const std::optional<VehicleReport>& r) {
+  if (!r) return task::EndReason::kSimTimeout;
+  return usable(*r) ? task::EndReason::kNone : task::EndReason::kBlowUp;
+}
+
 /// After step `step` of an episode: whether it stops, recording why in `summary`. An episode
 /// that reached its goal with options.run_full_time goes on (`task_ended` set: no more
 /// transitions or return), so that the evaluation sees the vehicle hold station.
@@ -135,14 +142,8 @@ EpisodeStepper::EpisodeStepper(const task::TaskConfig& task, VehicleLink& link,
   if (options.noise) options.noise->reset();
 
   report_ = link.reset(options.start);
-  if (!report_) {
-    summary_.end_reason = task::EndReason::kSimTimeout;
-    return;
-  }
-  if (!usable(*report_)) {
-    summary_.end_reason = task::EndReason::kBlowUp;
-    return;
-  }
+  summary_.end_reason = unusable_reason(report_);
+  if (summary_.end_reason != task::EndReason::kNone) return;
   previous_action_ = task::ActionVector::Zero(n);
   action_.resize(n);
   task::build_state(task, report_->observation, options.goal_ned_m, previous_action_, state_,
@@ -174,12 +175,8 @@ void EpisodeStepper::step() {
   }
   std::optional<VehicleReport> next = link_.step(thrust_n_);
   running_ = false;  // until this step is through
-  if (!next) {
-    summary_.end_reason = task::EndReason::kSimTimeout;
-    return;
-  }
-  if (!usable(*next)) {
-    summary_.end_reason = task::EndReason::kBlowUp;
+  if (const task::EndReason why = unusable_reason(next); why != task::EndReason::kNone) {
+    summary_.end_reason = why;
     return;
   }
   const double next_distance = (goal - next->observation.position_ned_m).norm();

@@ -30,12 +30,8 @@ QuickEvaluator::QuickEvaluator(const sim::VehicleModel& model, const task::TaskC
 }
 
 ValidationScore QuickEvaluator::evaluate(const nn::Mlp& network, int threads) const {
-  if (threads <= 1) {
-    agent::PolicyController controller(network, task_);
-    return score_against_reference(run(controller), reference_);
-  }
   // A controller per thread; each way-point's row in its own slot, the same rows as one thread.
-  const int used = std::min<int>(threads, static_cast<int>(episodes_.size()));
+  const int used = std::max(1, std::min<int>(threads, static_cast<int>(episodes_.size())));
   std::vector<agent::PolicyController> controllers;
   for (int w = 0; w < used; ++w) controllers.emplace_back(network, task_);
   std::vector<SummaryRow> rows(episodes_.size());
