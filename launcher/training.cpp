@@ -251,6 +251,9 @@ class TrainingSession {
   /// One line on the mode and the budget; in reproducible mode the snapshot folder.
   void announce_mode();
   SupervisionOutcome supervise_pass();
+  /// Why the wall-clock budget stopped the run, with the learner's updates where it stopped
+  /// before learner.max_updates.
+  std::string budget_used_message(double max_train_s) const;
   void evaluate_newest_weights();
   /// Reproducible mode: the quick evaluation of up to max_count of the learner's snapshots.
   void review_snapshots(std::size_t max_count);
@@ -469,6 +472,17 @@ bool TrainingSession::heard(Heard verdict, const std::string& channel, const cha
   return false;
 }
 
+std::string TrainingSession::budget_used_message(double max_train_s) const {
+  std::string message = fmt::format("training budget of {} used", format_duration(max_train_s));
+  // A slow machine ends the phase before learner.max_updates: say how far it got.
+  const auto& stats = monitor_.learner_stats();
+  if (ctx_.rc.learner_max_updates > 0 && stats && stats->updates < ctx_.rc.learner_max_updates) {
+    message += fmt::format(" after {} of learner.max_updates {} updates", stats->updates,
+                           ctx_.rc.learner_max_updates);
+  }
+  return message;
+}
+
 SupervisionOutcome TrainingSession::supervise_pass() {
   transport_->handle(100);
   if (signals::stop_requested()) return {true, 130, "stopped by the user"};
@@ -478,7 +492,7 @@ SupervisionOutcome TrainingSession::supervise_pass() {
   // result depend on the machine's speed.
   const double max_train_s = ctx_.rc.run.reproducible ? 0.0 : ctx_.rc.run.max_train_s;
   if (max_train_s > 0 && wall_s() >= max_train_s) {
-    return {true, 0, fmt::format("training budget of {} used", format_duration(max_train_s))};
+    return {true, 0, budget_used_message(max_train_s)};
   }
   SupervisionOutcome outcome = supervisor_.poll();
   if (outcome.stop) return outcome;

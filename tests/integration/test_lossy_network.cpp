@@ -113,6 +113,9 @@ TEST(LossyNetwork, TrainingGoesOnWithTenPercentDatagramLoss) {
   ASSERT_TRUE(WIFEXITED(status)) << train.log();
   EXPECT_EQ(WEXITSTATUS(status), 0) << train.log();
   EXPECT_NE(train.log().find("training budget of"), std::string::npos) << train.log();
+  // 30 s on a lossy link is far short of the preset's TD3 phase: the log says how far it got.
+  EXPECT_NE(train.log().find("of learner.max_updates 300000 updates"), std::string::npos)
+      << train.log();
   EXPECT_EQ(train.log().find("restarting"), std::string::npos) << "nothing hung: " << train.log();
 
   // Steps to the end (none in the last 10 s would mean a deadlock), and experience arrives.
