@@ -251,8 +251,8 @@ class TrainingSession {
   /// One line on the mode and the budget; in reproducible mode the snapshot folder.
   void announce_mode();
   SupervisionOutcome supervise_pass();
-  /// Why the wall-clock budget stopped the run, with the learner's updates where it stopped
-  /// before learner.max_updates.
+  /// Why the wall-clock budget stopped the run; where that came before learner.max_updates, the
+  /// updates in the learner's last statistics message (the learner goes on until it is stopped).
   std::string budget_used_message(double max_train_s) const;
   void evaluate_newest_weights();
   /// Reproducible mode: the quick evaluation of up to max_count of the learner's snapshots.
