@@ -195,7 +195,8 @@ CandidateSearch search_candidate(const FinetuneStageInput& in, const nn::Mlp& st
                                 : fmt::format(" candidate {}/{}", index + 1, in.config.candidates);
   bool past_cap = false;  // the search ends after this iteration (search_past_cap)
   const auto progress = [&](const tuning::FinetuneIteration& it, const nn::Mlp& weights) {
-    if (const auto why = search_past_cap(in.config, in.reproducible, it.elapsed_s, it.iteration)) {
+    if (const auto why = search_past_cap(in.config, in.reproducible, it.elapsed_s, it.iteration,
+                                         seconds_since(in.training_start), index > 0)) {
       out << "auvrl train: fine-tuning" << label << ": " << *why << "\n";
       past_cap = true;
     }
@@ -352,28 +353,44 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
                                                 double searches_s, int done) {
   if (done < 1 || done >= config.candidates || reproducible) return std::nullopt;
   const double pace_s = searches_s / done;
+  const double needed_s = config.candidate_min_fraction * pace_s;
+  if (config.candidates_within_s <= 0 || training_s + needed_s <= config.candidates_within_s) {
+    return std::nullopt;
+  }
   const std::string searched =
       fmt::format("{} of {} candidates searched after {:.1f} s of training", done,
                   config.candidates, training_s);
-  if (next_ends_past(config.candidates_within_s, training_s, searches_s, done)) {
+  if (config.candidate_min_fraction >= 1.0) {
     return fmt::format(
         "{}; another would end at about {:.1f} s, past finetune.candidates_within_s ({:g} s): "
         "choosing among these",
         searched, training_s + pace_s, config.candidates_within_s);
   }
-  return std::nullopt;
+  return fmt::format(
+      "{}; finetune.candidate_min_fraction ({:g}) of another would end at about {:.1f} s, past "
+      "finetune.candidates_within_s ({:g} s): choosing among these",
+      searched, config.candidate_min_fraction, training_s + needed_s, config.candidates_within_s);
 }
 
 std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
-                                           double search_s, int done) {
-  if (reproducible || done < 1 || done >= config.iterations ||
-      !next_ends_past(config.max_search_s, search_s, search_s, done)) {
-    return std::nullopt;
+                                           double search_s, int done, double training_s,
+                                           bool further_candidate) {
+  if (reproducible || done < 1 || done >= config.iterations) return std::nullopt;
+  const std::string ended = fmt::format("ended after iteration {} of {} at {:.1f} s of searching",
+                                        done, config.iterations, search_s);
+  if (next_ends_past(config.max_search_s, search_s, search_s, done)) {
+    return fmt::format(
+        "{}; the next would end at about {:.1f} s, past finetune.max_search_s ({:g} s)", ended,
+        search_s + search_s / done, config.max_search_s);
   }
-  return fmt::format(
-      "ended after iteration {} of {} at {:.1f} s of searching; the next would end at about "
-      "{:.1f} s, past finetune.max_search_s ({:g} s)",
-      done, config.iterations, search_s, search_s + search_s / done, config.max_search_s);
+  if (further_candidate && config.candidate_min_fraction < 1.0 &&
+      next_ends_past(config.candidates_within_s, training_s, search_s, done)) {
+    return fmt::format(
+        "{}; the next would end at about {:.1f} s of training, past "
+        "finetune.candidates_within_s ({:g} s)",
+        ended, training_s + search_s / done, config.candidates_within_s);
+  }
+  return std::nullopt;
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {

@@ -69,9 +69,9 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
                            std::ostream& out);
 
 /// Why the fine-tuning starts no further candidate after `done` searches, if so: an
-/// asynchronous run whose next search, at the mean pace of the searches so far (searches_s for
-/// the `done` of them), would end past config.candidates_within_s (when > 0) of training
-/// (training_s so far). Nothing before the
+/// asynchronous run where config.candidate_min_fraction of the next search (all of it at 1), at
+/// the mean pace of the searches so far (searches_s for the `done` of them), would end past
+/// config.candidates_within_s (when > 0) of training (training_s so far). Nothing before the
 /// first search, when all are done (the loop ends anyway) or in a reproducible run, whose result
 /// must not depend on the machine's speed.
 std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& config,
@@ -80,10 +80,13 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
 
 /// Why an asynchronous run's search ends after `done` iterations of its config.iterations, if
 /// so: at the mean pace of those (search_s for them, from this search's start), the next would
-/// end past config.max_search_s (when > 0) of this search. Never in a reproducible run, nor
-/// after the last iteration (the search ends there anyway).
+/// end past config.max_search_s (when > 0) of this search, or, for a further candidate
+/// (`further_candidate`: not the first search) with config.candidate_min_fraction below 1,
+/// past config.candidates_within_s (when > 0) of training (training_s so far). Never in a
+/// reproducible run, nor after the last iteration (the search ends there anyway).
 std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
-                                           double search_s, int done);
+                                           double search_s, int done, double training_s = 0,
+                                           bool further_candidate = false);
 
 /// The file in a run directory that names the policy its fine-tuning started from: relative to
 /// the run directory when inside it, so that the run can be moved.

@@ -106,6 +106,9 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
   t.field("candidates_within_s", &C::candidates_within_s, "s, 0: no limit",
           "an asynchronous run starts a further candidate only if it would end within this "
           "many seconds of the training's start, at the pace of those before");
+  t.field("candidate_min_fraction", &C::candidate_min_fraction, "0..1, 1: whole searches",
+          "with candidates_within_s: a further candidate starts if this share of it would end "
+          "in time, and then ends by candidates_within_s");
   t.field("max_search_s", &C::max_search_s, "s, 0: no cap",
           "an asynchronous run's wall-clock cap on each search, from its own start: a search "
           "ends once its next iteration would end past it, keeping the best validated weights");

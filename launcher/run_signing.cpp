@@ -33,7 +33,8 @@ std::vector<std::string> sign_policies(const std::string& dir, const std::string
     return signed_files;
   }
   if (!signed_files.empty()) {
-    out << "auvrl: " << signed_files.size() << " policies signed with " << key_path
+    out << "auvrl: " << signed_files.size() << (signed_files.size() == 1 ? " policy" : " policies")
+        << " signed with " << key_path
         << " (FILE.sig; a vehicle checks them with auv_controller --trust-key "
         << (fs::path(key_path).parent_path() / "run.pub").string() << ")\n";
   }

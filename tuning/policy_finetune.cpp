@@ -109,6 +109,8 @@ void FinetuneConfig::validate() const {
   require(candidates >= 1 && candidates <= 64, "candidates must be in [1, 64]");
   require(std::isfinite(candidates_within_s) && candidates_within_s >= 0.0,
           "candidates_within_s must be >= 0 s (0: no limit)");
+  require(candidate_min_fraction > 0.0 && candidate_min_fraction <= 1.0,
+          "candidate_min_fraction must be in (0, 1]");
   require(std::isfinite(max_search_s) && max_search_s >= 0.0,
           "max_search_s must be >= 0 s (0: no cap)");
   require(selection_seed != eval::EvaluationConfig{}.seed,

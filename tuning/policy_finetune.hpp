@@ -131,6 +131,12 @@ struct FinetuneConfig {
   /// or `auvrl finetune`'s start; s; 0: no limit), so that a slower machine keeps the training's
   /// minute with fewer candidates. A reproducible run searches them all.
   double candidates_within_s = 0.0;
+  /// With candidates_within_s: a further candidate starts when this share of its iterations
+  /// would end in time, at the pace of those before, and then ends by candidates_within_s
+  /// (the iteration it ends at is validated, and the best validated weights are kept), so that
+  /// a machine with time for most of a further search still gets a second choice. 1: only a
+  /// whole further search starts (and none is cut at candidates_within_s).
+  double candidate_min_fraction = 1.0;
   /// An asynchronous run's wall-clock cap on each search, from that search's start (s; 0: no
   /// cap): a search ends early once, at the mean pace of its iterations so far, the next would
   /// end past it; the iteration it ends at is validated, and the best validated weights so far

@@ -313,6 +313,49 @@ TEST(CandidatesWithinTest, AFurtherSearchOnlyWhenItEndsWithinTheLimit) {
   EXPECT_FALSE(no_further_candidate(config, false, 30, 15, 1));
 }
 
+// With finetune.candidate_min_fraction below 1, a further candidate starts when that share of
+// it ends within finetune.candidates_within_s, and the log says which share.
+TEST(CandidatesWithinTest, APartOfAFurtherSearchIsEnoughWithAMinimumFraction) {
+  tuning::FinetuneConfig config;
+  config.candidates = 2;
+  config.candidates_within_s = 55;
+  // 47 s of training, one search of 14 s: a whole one would end at 61 s.
+  EXPECT_TRUE(no_further_candidate(config, false, 47, 14, 1));
+  config.candidate_min_fraction = 0.5;
+  // Half of it ends at 54 s: it starts.
+  EXPECT_FALSE(no_further_candidate(config, false, 47, 14, 1));
+  // 50 s: half would end at 57 s.
+  const auto why = no_further_candidate(config, false, 50, 14, 1);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("finetune.candidate_min_fraction (0.5) of another would end at about 57.0 s"),
+            std::string::npos)
+      << *why;
+  EXPECT_FALSE(no_further_candidate(config, true, 50, 14, 1));
+}
+
+// A further candidate started on a share of it (finetune.candidate_min_fraction below 1) ends
+// once its next iteration would end past finetune.candidates_within_s of training; the first
+// search is never cut there (a longer TD3 phase asked for keeps its search), nor any search with
+// the fraction at 1, nor a reproducible run's.
+TEST(MaxSearchTest, AFurtherCandidateEndsByTheCandidatesLimit) {
+  tuning::FinetuneConfig config;
+  config.iterations = 72;
+  config.candidates_within_s = 55;
+  config.candidate_min_fraction = 0.5;
+  // 40 iterations in 7.6 s, at 54.7 s of training: the next would end at 54.89 s.
+  EXPECT_FALSE(search_past_cap(config, false, 7.6, 40, 54.7, true));
+  // 41 in 7.8 s at 54.9 s: 55.09 s.
+  const auto why = search_past_cap(config, false, 7.8, 41, 54.9, true);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("ended after iteration 41 of 72 at 7.8 s of searching"), std::string::npos)
+      << *why;
+  EXPECT_NE(why->find("past finetune.candidates_within_s (55 s)"), std::string::npos) << *why;
+  EXPECT_FALSE(search_past_cap(config, false, 7.8, 41, 54.9, false));
+  EXPECT_FALSE(search_past_cap(config, true, 7.8, 41, 54.9, true));
+  config.candidate_min_fraction = 1;
+  EXPECT_FALSE(search_past_cap(config, false, 7.8, 41, 54.9, true));
+}
+
 // An asynchronous run's search ends once its next iteration, at the mean pace of those done,
 // would end past finetune.max_search_s of that search; never a reproducible run's, nor after its
 // last iteration, nor without a cap.

@@ -704,7 +704,8 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
   EXPECT_THROW(finetune_policy(nessie(), fast_task(), committed_policy(), c, 1),
                std::invalid_argument);
   for (auto bad :
-       {+[](FinetuneConfig& f) { f.pairs = 0; }, +[](FinetuneConfig& f) { f.episodes = 0; },
+       {+[](FinetuneConfig& f) { f.pairs = 0; },
+        +[](FinetuneConfig& f) { f.episodes = 0; },
         +[](FinetuneConfig& f) { f.learning_rate = -1; },
         +[](FinetuneConfig& f) { f.random_heading_fraction = 2; },
         +[](FinetuneConfig& f) { f.facing_away_fraction = -0.1; },
@@ -714,10 +715,14 @@ TEST(FinetunePolicy, RefusesBadSettingsAndANetworkThatDoesNotFit) {
         +[](FinetuneConfig& f) { f.integration_substeps = -1; },
         +[](FinetuneConfig& f) { f.pid_lag_weight = -1; },
         +[](FinetuneConfig& f) { f.pid_lead_s = std::numeric_limits<double>::infinity(); },
-        +[](FinetuneConfig& f) { f.iterations = -1; }, +[](FinetuneConfig& f) { f.candidates = 0; },
+        +[](FinetuneConfig& f) { f.iterations = -1; },
+        +[](FinetuneConfig& f) { f.candidates = 0; },
         +[](FinetuneConfig& f) { f.candidates = 65; },
         +[](FinetuneConfig& f) { f.candidates_within_s = -1; },
         +[](FinetuneConfig& f) { f.candidates_within_s = std::nan(""); },
+        +[](FinetuneConfig& f) { f.candidate_min_fraction = 0; },
+        +[](FinetuneConfig& f) { f.candidate_min_fraction = 1.5; },
+        +[](FinetuneConfig& f) { f.candidate_min_fraction = std::nan(""); },
         +[](FinetuneConfig& f) { f.selection_seed = 1; }}) {
     FinetuneConfig f;
     bad(f);
