@@ -352,15 +352,16 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
                                                 bool reproducible, double training_s,
                                                 double searches_s, int done) {
   if (done < 1 || done >= config.candidates || reproducible) return std::nullopt;
-  const double pace_s = searches_s / done;
-  const double needed_s = config.candidate_min_fraction * pace_s;
-  if (config.candidates_within_s <= 0 || training_s + needed_s <= config.candidates_within_s) {
+  // The share of a search that must fit, projected as the search caps project their iterations.
+  const double fraction = config.candidate_min_fraction;
+  if (!next_ends_past(config.candidates_within_s, training_s, fraction * searches_s, done)) {
     return std::nullopt;
   }
+  const double pace_s = searches_s / done;
   const std::string searched =
       fmt::format("{} of {} candidates searched after {:.1f} s of training", done,
                   config.candidates, training_s);
-  if (config.candidate_min_fraction >= 1.0) {
+  if (fraction >= 1.0) {
     return fmt::format(
         "{}; another would end at about {:.1f} s, past finetune.candidates_within_s ({:g} s): "
         "choosing among these",
@@ -369,28 +370,29 @@ std::optional<std::string> no_further_candidate(const tuning::FinetuneConfig& co
   return fmt::format(
       "{}; finetune.candidate_min_fraction ({:g}) of another would end at about {:.1f} s, past "
       "finetune.candidates_within_s ({:g} s): choosing among these",
-      searched, config.candidate_min_fraction, training_s + needed_s, config.candidates_within_s);
+      searched, fraction, training_s + fraction * pace_s, config.candidates_within_s);
 }
 
 std::optional<std::string> search_past_cap(const tuning::FinetuneConfig& config, bool reproducible,
                                            double search_s, int done, double training_s,
                                            bool further_candidate) {
   if (reproducible || done < 1 || done >= config.iterations) return std::nullopt;
+  const bool past_search_cap = next_ends_past(config.max_search_s, search_s, search_s, done);
+  const bool past_candidates_limit =
+      further_candidate && config.candidate_min_fraction < 1.0 &&
+      next_ends_past(config.candidates_within_s, training_s, search_s, done);
+  if (!past_search_cap && !past_candidates_limit) return std::nullopt;  // the usual case
   const std::string ended = fmt::format("ended after iteration {} of {} at {:.1f} s of searching",
                                         done, config.iterations, search_s);
-  if (next_ends_past(config.max_search_s, search_s, search_s, done)) {
+  if (past_search_cap) {
     return fmt::format(
         "{}; the next would end at about {:.1f} s, past finetune.max_search_s ({:g} s)", ended,
         search_s + search_s / done, config.max_search_s);
   }
-  if (further_candidate && config.candidate_min_fraction < 1.0 &&
-      next_ends_past(config.candidates_within_s, training_s, search_s, done)) {
-    return fmt::format(
-        "{}; the next would end at about {:.1f} s of training, past "
-        "finetune.candidates_within_s ({:g} s)",
-        ended, training_s + search_s / done, config.candidates_within_s);
-  }
-  return std::nullopt;
+  return fmt::format(
+      "{}; the next would end at about {:.1f} s of training, past "
+      "finetune.candidates_within_s ({:g} s)",
+      ended, training_s + search_s / done, config.candidates_within_s);
 }
 
 std::optional<std::string> policy_named_in(const std::string& run_dir, const std::string& record) {
