@@ -247,6 +247,17 @@ start() {  # start NAME NAMESPACE CMD...: runs CMD in NAMESPACE, output in $out/
   pid_of[$name]=$!
   pids+=("$!")
 }
+started() {  # started NAME REGEX: waits up to 20 s for NAME's log to match REGEX; exit 1 if not
+  local name=$1 regex=$2
+  for _ in $(seq 1 200); do
+    grep -qE "$regex" "$out/$name.log" 2>/dev/null && return 0
+    kill -0 "${pid_of[$name]}" 2>/dev/null || break
+    sleep 0.1
+  done
+  echo "multihost: $name did not print /$regex/ within 20 s (it exited, or hangs); its log:" >&2
+  sed 's/^/  /' "$out/$name.log" >&2
+  exit 1
+}
 stop() {  # stop NAME...: SIGTERM, then wait up to 10 s (SIGKILL after)
   local name p
   for name in "$@"; do kill -TERM "${pid_of[$name]}" 2>/dev/null || true; done
@@ -293,7 +304,12 @@ start simA A "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_a[@]}" -
 identity sim-1
 start simC C "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_c[@]}" --vehicles 1 \
   --first-vehicle-id 1
-# An actor's first episode waits until the learner and the logger read its experience.
+# The learner and the logger print their first line once subscribed. LCM has no discovery, so
+# without this wait an actor's first episodes could go out before they listen.
+started learner '^auv_learner: .*, actor '
+started logger '^auv_logger: logging '
+# An actor's first episode waits until the learner and the logger read its experience (over DDS,
+# where a writer delivers only to the readers it has discovered).
 # shellcheck disable=SC2054  # learner,logger is one value, a list of roles
 actor_args=(--layout extended --reward shaped --max-steps 100 --noise gaussian
   --wait-for-readers learner,logger)
