@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <filesystem>
 #include <fstream>
 
 #include "common/process.hpp"
@@ -14,6 +15,8 @@
 #include "launcher/format.hpp"
 
 namespace auvrl::launcher {
+
+namespace fs = std::filesystem;
 
 double SteadyClock::now_s() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -75,7 +78,47 @@ std::string last_line(const std::string& log_path) {
 }  // namespace
 
 void Supervisor::start_all() {
-  for (auto& role : roles_) start(*role);
+  started_all_s_ = clock_.now_s();
+  for (auto& role : roles_) {
+    if (!role->spec.starts_after_listeners) start(*role);
+  }
+  start_after_listeners();
+}
+
+bool Supervisor::printed_since_start(const Role& role) const {
+  std::ifstream in(role.spec.log_path);
+  in.seekg(static_cast<std::streamoff>(role.log_offset));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(role.spec.listening_text, 0) == 0) return true;
+  }
+  return false;
+}
+
+void Supervisor::start_after_listeners() {
+  if (listeners_waited_) return;
+  std::vector<const Role*> silent;
+  for (auto& role : roles_) {
+    if (role->spec.listening_text.empty() || !role->proc || role->listening) continue;
+    role->listening = printed_since_start(*role);
+    if (!role->listening) silent.push_back(role.get());
+  }
+  if (!silent.empty() && clock_.now_s() - started_all_s_ < settings_.listen_wait_s) return;
+  listeners_waited_ = true;
+  std::vector<Role*> waiting;
+  for (auto& role : roles_) {
+    if (role->spec.starts_after_listeners && !role->proc) waiting.push_back(role.get());
+  }
+  for (const Role* role : silent) {
+    if (waiting.empty()) break;
+    say() << fmt::format(
+        "{} not listening after {:g} s (no line beginning \"{}\" in {}); "
+        "starting {}{} anyway\n",
+        role->spec.name, settings_.listen_wait_s, role->spec.listening_text, role->spec.log_path,
+        waiting.front()->spec.name,
+        waiting.size() > 1 ? fmt::format(" and {} more", waiting.size() - 1) : "");
+  }
+  for (Role* role : waiting) start(*role);
 }
 
 std::ostream& Supervisor::say() {
@@ -94,6 +137,10 @@ int Supervisor::alive_key(const Role& role) const {
 void Supervisor::start(Role& role) {
   // The replaced process's signs of life no longer count (nor does its entry stay).
   if (role.proc) alive_by_pid_.erase(role.proc->pid());
+  std::error_code no_log;
+  const std::uintmax_t log_size = fs::file_size(role.spec.log_path, no_log);
+  role.log_offset = no_log ? 0 : log_size;
+  role.listening = false;
   role.proc = starter_.start(role.spec.argv(role.restarts_s.size()), role.spec.log_path);
   // The new process is watched from its own first sign of life on.
   alive_by_pid_.erase(role.proc->pid());
@@ -177,9 +224,10 @@ SupervisionOutcome Supervisor::on_exit(Role& role) {
 
 SupervisionOutcome Supervisor::poll() {
   const bool heard = anyone_heard();
+  start_after_listeners();
   SupervisionOutcome outcome;
   for (auto& role : roles_) {
-    if (role->finished) continue;
+    if (role->finished || (!role->proc && !role->waiting_restart)) continue;
     if (role->waiting_restart) {
       if (clock_.now_s() >= role->restart_due_s) {
         role->waiting_restart = false;

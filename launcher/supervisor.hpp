@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <map>
@@ -77,6 +78,13 @@ struct RoleSpec {
   std::function<std::vector<std::string>(std::size_t restarts)> argv;
   std::string log_path;  ///< the process's output (appended over restarts)
   int actor_id = -1;     ///< an actor's id (its signs of life are its EPISODE reports)
+  /// How the line begins that the role prints once it listens (its subscriptions made); empty:
+  /// nothing to wait for.
+  std::string listening_text;
+  /// Its first start waits until every role with a listening_text has printed that line since its
+  /// own start (or listen_wait_s has passed): LCM has no discovery, so what a role publishes before
+  /// its readers subscribe is lost to them.
+  bool starts_after_listeners = false;
 };
 
 /// The rules of supervision (RunSettings' fields of the same names).
@@ -88,6 +96,8 @@ struct SupervisorSettings {
   double max_backoff_s = 30.0;      ///< the longest delay before a restart, s
   double listen_gap_s = 1.0;        ///< a pause of the supervisor's own longer than this is
                                     ///< not counted as the processes' silence, s
+  double listen_wait_s = 30.0;      ///< how long the roles that start after the listeners wait
+                                    ///< for them before they start anyway, s
 };
 
 /// What a supervision pass concluded.
@@ -113,7 +123,8 @@ class Supervisor {
   void on_start(std::function<void(const std::string& name, int pid)> hook) {
     on_start_ = std::move(hook);
   }
-  /// Starts every role in the order added.
+  /// Starts every role in the order added, except those that start after the listeners:
+  /// poll() starts them once the listeners listen.
   void start_all();
   /// A sign of life from process pid (heartbeats, learner figures).
   void heard_from_pid(int pid) { alive_by_pid_[pid] = clock_.now_s(); }
@@ -135,10 +146,16 @@ class Supervisor {
     std::deque<double> restarts_s;  ///< times of the restarts within the window
     double restart_due_s = 0;
     bool waiting_restart = false;
-    bool finished = false;  ///< ended by itself, successfully, and should stay ended
+    bool finished = false;          ///< ended by itself, successfully, and should stay ended
+    std::uintmax_t log_offset = 0;  ///< the size of its log at its latest start, bytes
+    bool listening = false;         ///< printed its listening_text since its latest start
   };
 
   void start(Role& role);
+  /// Starts the roles that wait for the listeners once every listener listens or
+  /// listen_wait_s has passed since start_all() (saying which did not listen).
+  void start_after_listeners();
+  bool printed_since_start(const Role& role) const;
   bool anyone_heard();
   void watch_hang(Role& role, bool anyone_heard);
   SupervisionOutcome on_exit(Role& role);
@@ -157,6 +174,8 @@ class Supervisor {
   /// actor id (episode reports), s.
   std::map<int, double> alive_by_pid_, alive_by_actor_;
   std::optional<double> last_poll_s_;
+  double started_all_s_ = 0;
+  bool listeners_waited_ = false;  ///< the roles that wait for the listeners were started
 };
 
 }  // namespace auvrl::launcher

@@ -17,6 +17,7 @@
 
 #include "common/channels.hpp"
 #include "common/dds_security.hpp"
+#include "common/listening_lines.hpp"
 #include "common/nn/serialize.hpp"
 #include "common/signals.hpp"
 #include "common/transport.hpp"
@@ -86,8 +87,12 @@ std::vector<std::string> concat(std::vector<std::string> a, const std::vector<st
 RoleSpec fixed_role(const RunContext& ctx, std::string name, RoleKind kind,
                     std::vector<std::string> argv) {
   const std::string log_path = (fs::path(ctx.run_dir) / "processes" / (name + ".log")).string();
-  return {std::move(name), kind, [argv = std::move(argv)](std::size_t) { return argv; }, log_path,
-          -1};
+  RoleSpec role;
+  role.name = std::move(name);
+  role.kind = kind;
+  role.argv = [argv = std::move(argv)](std::size_t) { return argv; };
+  role.log_path = log_path;
+  return role;
 }
 
 /// The DDS Security identity of participant `name` (scripts/pki.sh's names: learner, logger,
@@ -175,6 +180,8 @@ RoleSpec actor_role(const RunContext& ctx, int i, int cpu, const std::string& bi
   const std::string config_path = ctx.config_path;
   RoleSpec role = fixed_role(ctx, "actor" + std::to_string(i), RoleKind::kActor, {});
   role.actor_id = i;
+  // Over LCM (no discovery) only this keeps its first episodes from going out unheard.
+  role.starts_after_listeners = true;
   role.argv = [=](std::size_t restarts) {
     return concat({bin + "auv_actor", "--config", config_path, "--actor-id", std::to_string(i),
                    "--vehicle-id", std::to_string(i), "--seed",
@@ -196,6 +203,7 @@ std::vector<RoleSpec> make_roles(const RunContext& ctx,
       ctx, "logger", RoleKind::kLogger,
       concat(concat({bin + "auv_logger", "--dir", (run_dir / "logs").string()}, transport_args),
              identity_args(ctx, "logger"))));
+  roles.back().listening_text = listening::kLogger;
   // Actors (each beside its simulator) on the CPUs the learner does not have, if any.
   std::vector<int> actor_cpus;
   for (int c = 0; c < ctx.cpus; ++c) {
@@ -220,6 +228,7 @@ std::vector<RoleSpec> make_roles(const RunContext& ctx,
   learner.argv = [base, checkpoints](std::size_t) {
     return has_checkpoint_file(checkpoints) ? concat(base, {"--resume"}) : base;
   };
+  learner.listening_text = listening::kLearner;
   roles.push_back(std::move(learner));
   for (int i = 0; i < ctx.actors; ++i) {
     roles.push_back(actor_role(ctx, i, cpu_of(i), bin, transport_args));

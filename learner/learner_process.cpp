@@ -3,6 +3,7 @@
 #include <vector>
 
 #include "common/cli.hpp"
+#include "common/listening_lines.hpp"
 #include "common/nn/mlp.hpp"
 #include "common/signals.hpp"
 #include "common/transport_options.hpp"
@@ -59,7 +60,7 @@ void run_learner_process(const LearnerNodeConfig& config, const LearnerProcessOp
   signals::install_stop_handlers();
   LearnerNode node(config, *transport, log);
   if (options.resume) node.resume();
-  log << "auv_learner: " << to_string(config.ddpg.algo) << ", actor "
+  log << listening::kLearner << to_string(config.ddpg.algo) << ", actor "
       << node.algorithm().actor().spec().describe() << ", buffer " << config.ddpg.replay_capacity
       << ", " << transport::describe(transport_config) << "\n";
   bool announced_done = false;

@@ -1,5 +1,6 @@
 #include "logger/logger_process.hpp"
 
+#include "common/listening_lines.hpp"
 #include "common/signals.hpp"
 
 namespace auvrl::logger {
@@ -24,7 +25,7 @@ int run_logger_process(const LoggerConfig& config,
   auto transport = transport::make_transport(transport_config);
   signals::install_stop_handlers();
   Logger logger(*transport, config);
-  log << "auv_logger: logging '" << config.channels << "' into " << config.dir << " ("
+  log << listening::kLogger << config.channels << "' into " << config.dir << " ("
       << transport::describe(transport_config) << ")\n";
   while (!signals::stop_requested()) logger.poll(50);
   const std::string summary = logger.finish(schema);

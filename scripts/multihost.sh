@@ -306,7 +306,7 @@ start simC C "$bin/auv_sim" "${common[@]}" "${id_flags[@]}" "${lockstep_c[@]}" -
   --first-vehicle-id 1
 # The learner and the logger print their first line once subscribed. LCM has no discovery, so
 # without this wait an actor's first episodes could go out before they listen.
-started learner '^auv_learner: .*, actor '
+started learner '^auv_learner: listening: '
 started logger '^auv_logger: logging '
 # An actor's first episode waits until the learner and the logger read its experience (over DDS,
 # where a writer delivers only to the readers it has discovered).

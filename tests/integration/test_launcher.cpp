@@ -59,6 +59,8 @@ TEST_P(LauncherSupervision, RestartsKilledProcessesStopsCleanlyAndResumes) {
   const fs::path run(dir);
   ASSERT_TRUE(wait_for([&] { return read_csv(run / "episodes.csv").size() >= 20; }, 30))
       << train.log();
+  // The actors started once the learner and the logger said they listen, not after a wait.
+  EXPECT_EQ(train.log().find("not listening"), std::string::npos) << train.log();
   const int actor = read_pid(run / "processes" / "actor0.pid");
   ASSERT_GT(actor, 0);
   ASSERT_EQ(kill(actor, SIGKILL), 0);

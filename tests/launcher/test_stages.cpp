@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "child_process.hpp"
+#include "common/listening_lines.hpp"
 #include "common/nn/file_io.hpp"
 #include "common/nn/serialize.hpp"
 #include "launcher/launcher.hpp"
@@ -464,7 +465,13 @@ TEST_F(RolesTest, StartOrderKindsAndLogs) {
   for (const auto& r : roles) {
     const auto argv = r.argv(0);
     EXPECT_EQ(argv[argv.size() - 2], "--transport") << r.name;
+    // Only the actors wait, and only for the learner and the logger.
+    EXPECT_EQ(r.starts_after_listeners, r.kind == RoleKind::kActor) << r.name;
+    const bool listens = r.kind == RoleKind::kLearner || r.kind == RoleKind::kLogger;
+    EXPECT_EQ(r.listening_text.empty(), !listens) << r.name;
   }
+  EXPECT_EQ(find(roles, "learner").listening_text, listening::kLearner);
+  EXPECT_EQ(find(roles, "logger").listening_text, listening::kLogger);
 }
 
 TEST_F(RolesTest, SecuredRunsGiveEachProcessItsIdentity) {

@@ -2,11 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "agent_test_util.hpp"
 #include "launcher/supervisor.hpp"
 #include "tests/launcher/manual_clock.hpp"
 
@@ -330,6 +332,111 @@ TEST_F(SupervisorTest, StopsByKindWithTheirGrace) {
   EXPECT_EQ(starter.newest("learner")->terminate_grace_s, 120);
   EXPECT_EQ(starter.newest("sim0")->terminate_order, -1);
   EXPECT_EQ(starter.newest("logger")->terminate_order, -1);
+}
+
+/// A logger and a learner that print a line once they listen, and two actors that wait for it;
+/// their logs in a scratch directory.
+class ListeningTest : public SupervisorTest {
+ protected:
+  void add_roles() {
+    for (const auto& [name, kind] :
+         {std::pair{"logger", RoleKind::kLogger}, std::pair{"learner", RoleKind::kLearner}}) {
+      RoleSpec spec = role(name, kind);
+      spec.log_path = dir.path(std::string(name) + ".log");
+      spec.listening_text = std::string(name) + ": listening: ";
+      supervisor->add(spec);
+    }
+    for (int i = 0; i < 2; ++i) {
+      RoleSpec actor = role("actor" + std::to_string(i), RoleKind::kActor, i);
+      actor.starts_after_listeners = true;
+      supervisor->add(actor);
+    }
+  }
+  void print(const std::string& name, const std::string& text) {
+    std::ofstream(dir.path(name + ".log"), std::ios::app) << text;
+  }
+  int actor_starts() const { return starter.starts("actor0") + starter.starts("actor1"); }
+
+  test_support::TempDir dir;
+};
+
+TEST_F(ListeningTest, ActorsStartOnceTheLearnerAndTheLoggerListen) {
+  make({});
+  add_roles();
+  supervisor->start_all();
+  EXPECT_EQ(starter.started.size(), 2u);
+  EXPECT_EQ(supervisor->pid("actor0"), -1);
+  run_until(1);
+  print("logger", "logger: listening: every channel\n");
+  run_until(2);
+  EXPECT_EQ(actor_starts(), 0) << "the learner does not listen yet";
+  print("learner", "learner: listen");  // a line half written
+  run_until(3);
+  EXPECT_EQ(actor_starts(), 0);
+  print("learner", "ing: td3\n");
+  supervisor->poll();
+  EXPECT_EQ(starter.starts("actor0"), 1);
+  EXPECT_EQ(starter.starts("actor1"), 1);
+  EXPECT_EQ(starter.newest("actor1")->pid, 103) << "started in the order added";
+  run_until(10);
+  EXPECT_EQ(actor_starts(), 2) << "started once";
+  EXPECT_EQ(out.str(), "");
+  // A restarted actor does not wait again.
+  crash("actor0");
+  run_until(11);
+  EXPECT_EQ(starter.starts("actor0"), 2);
+}
+
+TEST_F(ListeningTest, OnlyALineSinceTheLatestStartCounts) {
+  make({});
+  print("logger", "logger: listening: in a run before the resume\n");
+  print("learner", "learner: listening: in a run before the resume\n");
+  add_roles();
+  supervisor->start_all();
+  run_until(2);
+  EXPECT_EQ(actor_starts(), 0);
+  // A line that only contains the text is not the line.
+  print("logger", "error: logger: listening: \n");
+  print("learner", "learner: listening: now\n");
+  run_until(3);
+  EXPECT_EQ(actor_starts(), 0);
+  print("logger", "logger: listening: now\n");
+  run_until(4);
+  EXPECT_EQ(actor_starts(), 2);
+}
+
+TEST_F(ListeningTest, ActorsStartAnywayAfterTheWaitSayingWhoDidNotListen) {
+  SupervisorSettings settings;
+  settings.listen_wait_s = 5;
+  make(settings);
+  add_roles();
+  supervisor->start_all();
+  print("learner", "learner: listening: td3\n");
+  run_until(4.95, 0.05);
+  EXPECT_EQ(actor_starts(), 0);
+  EXPECT_EQ(out.str(), "");
+  run_until(5.05, 0.05);
+  EXPECT_EQ(actor_starts(), 2);
+  EXPECT_EQ(out.str(),
+            "auvrl train: logger not listening after 5 s (no line beginning \"logger: "
+            "listening: \" in " +
+                dir.path("logger.log") + "); starting actor0 and 1 more anyway\n");
+}
+
+TEST_F(ListeningTest, AListenerRestartedBeforeItListenedIsWaitedFor) {
+  make({});
+  add_roles();
+  supervisor->start_all();
+  print("learner", "learner: listening: td3\n");
+  crash("logger");
+  run_until(0.2);
+  EXPECT_EQ(actor_starts(), 0);
+  run_until(1);  // restarted after 0.5 s
+  EXPECT_EQ(starter.starts("logger"), 2);
+  EXPECT_EQ(actor_starts(), 0);
+  print("logger", "logger: listening: every channel\n");
+  run_until(1.2);
+  EXPECT_EQ(actor_starts(), 2);
 }
 
 TEST(SteadyClockTest, NeverGoesBack) {
