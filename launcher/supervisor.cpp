@@ -99,9 +99,10 @@ void Supervisor::start_after_listeners() {
   if (listeners_waited_) return;
   std::vector<const Role*> silent;
   for (auto& role : roles_) {
-    if (role->spec.listening_text.empty() || !role->proc || role->listening) continue;
-    role->listening = printed_since_start(*role);
-    if (!role->listening) silent.push_back(role.get());
+    if (role->spec.listening_text.empty() || !role->proc) continue;
+    // One that ended since it said so listens no longer: its restart must say so again.
+    if (!role->waiting_restart && !role->listening) role->listening = printed_since_start(*role);
+    if (role->waiting_restart || !role->listening) silent.push_back(role.get());
   }
   if (!silent.empty() && clock_.now_s() - started_all_s_ < settings_.listen_wait_s) return;
   listeners_waited_ = true;
@@ -224,7 +225,6 @@ SupervisionOutcome Supervisor::on_exit(Role& role) {
 
 SupervisionOutcome Supervisor::poll() {
   const bool heard = anyone_heard();
-  start_after_listeners();
   SupervisionOutcome outcome;
   for (auto& role : roles_) {
     if (role->finished || (!role->proc && !role->waiting_restart)) continue;
@@ -244,6 +244,8 @@ SupervisionOutcome Supervisor::poll() {
     if (ended.exit_code != 0) return ended;  // giving up: the rest waits for the stop
     if (ended.stop) outcome = ended;         // the learner is done: the others still count
   }
+  // After the exits above: a listener that has just ended does not count as listening.
+  if (!outcome.stop) start_after_listeners();
   return outcome;
 }
 

@@ -439,6 +439,24 @@ TEST_F(ListeningTest, AListenerRestartedBeforeItListenedIsWaitedFor) {
   EXPECT_EQ(actor_starts(), 2);
 }
 
+TEST_F(ListeningTest, AListenerThatEndedAfterItListenedIsWaitedForAgain) {
+  make({});
+  add_roles();
+  supervisor->start_all();
+  print("logger", "logger: listening: every channel\n");
+  run_until(0.2);
+  crash("logger");
+  print("learner", "learner: listening: td3\n");
+  run_until(0.4);
+  EXPECT_EQ(actor_starts(), 0) << "the logger ended after it listened";
+  run_until(1);  // restarted after 0.5 s; its earlier line does not count
+  EXPECT_EQ(starter.starts("logger"), 2);
+  EXPECT_EQ(actor_starts(), 0);
+  print("logger", "logger: listening: every channel\n");
+  run_until(1.2);
+  EXPECT_EQ(actor_starts(), 2);
+}
+
 TEST(SteadyClockTest, NeverGoesBack) {
   SteadyClock clock;
   const double a = clock.now_s();
