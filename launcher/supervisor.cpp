@@ -110,8 +110,8 @@ void Supervisor::start_after_listeners() {
   for (auto& role : roles_) {
     if (role->spec.starts_after_listeners && !role->proc) waiting.push_back(role.get());
   }
+  if (waiting.empty()) return;
   for (const Role* role : silent) {
-    if (waiting.empty()) break;
     say() << fmt::format(
         "{} not listening after {:g} s (no line beginning \"{}\" in {}); "
         "starting {}{} anyway\n",
