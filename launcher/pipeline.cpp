@@ -155,11 +155,13 @@ void report_objective_terms(const FinetuneStageInput& in,
 }
 
 /// One search of the fine-tuning: its seed, the best validated weights (none: not kept) and
-/// what the search did.
+/// what the search did; or the searches' mean (finetune.average_candidates), with the first
+/// search's way-points and its own objective there.
 struct CandidateSearch {
   std::uint64_t seed = 0;
   FinetuneBest best;
   tuning::FinetuneResult result;
+  bool mean = false;  ///< the mean of the searches' kept weights, not a search
 };
 
 /// A file of candidate `index` (from 0) in the run directory: the first candidate's under the
@@ -257,32 +259,85 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
   return searches;
 }
 
-/// Runs the candidates' searches and returns the one to keep: with one searched, it; with more,
-/// the one whose kept weights (or the start, where a search kept none) pass the most criteria at
-/// the selection seed (tuning::choose_candidate; candidates.csv has each), scored after the
-/// searches so that a run that searches one spends nothing on the choice.
-CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
-                                  const eval::ValidationScore& before, std::ostream& out) {
-  std::vector<CandidateSearch> searches = run_candidate_searches(in, start, before, out);
-  if (searches.size() == 1) return std::move(searches.front());  // nothing to choose between
+/// The searches' mean as a further choice (finetune.average_candidates): the mean of the
+/// weights the searches kept, validated as they were. None where fewer than two kept weights,
+/// or where the mean does not rank above the trained policy (`before`) on the validation
+/// way-points, as a search's weights must to be kept.
+std::optional<CandidateSearch> mean_of_searches(const FinetuneStageInput& in,
+                                                const std::vector<CandidateSearch>& searches,
+                                                const eval::ValidationScore& before,
+                                                std::ostream& out) {
+  std::vector<const nn::Mlp*> kept;
+  for (const CandidateSearch& c : searches) {
+    if (c.best.net) kept.push_back(&*c.best.net);
+  }
+  if (kept.size() < 2) return std::nullopt;
+  nn::Mlp mean = nn::mean_of(kept);
+  const eval::ValidationScore score =
+      in.validation.evaluate(mean, tuning::search_threads(in.config));
+  if (!eval::ranks_above(score, before, finetune_ranking(in.config, in.max_hold_m))) {
+    out << "auvrl train: fine-tuning: the searches' mean scores no better than the trained "
+           "policy on the validation way-points: not a choice\n";
+    return std::nullopt;
+  }
+  CandidateSearch c{0, {score, std::move(mean), 0}, searches.front().result, true};
+  agent::PolicyController policy(*c.best.net, tuning::finetune_driving_task(in.task));
+  c.result.best_objective =
+      tuning::mean_objective_terms(in.model, in.task, policy, c.result.episodes, in.config)
+          .objective_s;
+  return c;
+}
+
+/// Scores each choice at the selection seed (tuning::SuiteSelector), says each, and returns the
+/// scores with their candidates.csv rows.
+std::vector<tuning::CandidateScore> score_candidates(const FinetuneStageInput& in,
+                                                     const std::vector<CandidateSearch>& choices,
+                                                     const nn::Mlp& start,
+                                                     std::vector<CandidatesRow>& rows,
+                                                     std::ostream& out) {
   const tuning::SuiteSelector selector(in.model, in.task, in.config.selection_seed,
                                        eval::kRobustnessEpisodesPerGroup,
                                        tuning::search_threads(in.config));
   std::vector<tuning::CandidateScore> scores;
-  std::vector<CandidatesRow> rows;
-  for (const CandidateSearch& c : searches) {
+  for (const CandidateSearch& c : choices) {
     const tuning::CandidateScore score = selector.score(c.best.net ? *c.best.net : start);
     scores.push_back(score);
     const int number = static_cast<int>(rows.size()) + 1;
     rows.push_back({number, c.seed, c.best.iteration, c.result.best_objective, score.groups_passing,
-                    selector.groups(), score.behind_late, score.behind_episodes, false});
+                    selector.groups(), score.behind_late, score.behind_episodes, false, c.mean});
+    const std::string who =
+        c.mean ? fmt::format("the mean of candidates 1-{}", number - 1)
+               : fmt::format("candidate {}/{} (seed {})", number, in.config.candidates, c.seed);
     out << fmt::format(
-        "auvrl train: fine-tuning candidate {}/{} (seed {}): objective {:.3f} s, {} of {} "
-        "robustness groups at seed {}, late on {} of {} way-points straight behind\n",
-        number, in.config.candidates, c.seed, c.result.best_objective, score.groups_passing,
-        selector.groups(), in.config.selection_seed, score.behind_late, score.behind_episodes);
+        "auvrl train: fine-tuning {}: objective {:.3f} s, {} of {} robustness groups at seed {}, "
+        "late on {} of {} way-points straight behind\n",
+        who, c.result.best_objective, score.groups_passing, selector.groups(),
+        in.config.selection_seed, score.behind_late, score.behind_episodes);
   }
-  const std::size_t chosen = tuning::choose_candidate(scores);
+  return scores;
+}
+
+/// Runs the candidates' searches and returns the one to keep: with one searched, it; with more,
+/// the one whose kept weights (or the start, where a search kept none) pass the most criteria at
+/// the selection seed (tuning::choose_candidate; candidates.csv has each), or their mean where
+/// finetune.average_candidates asks for it and tuning::keep_mean keeps it. Scored after the
+/// searches, so that a run that searches one spends nothing on the choice.
+CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& start,
+                                  const eval::ValidationScore& before, std::ostream& out) {
+  std::vector<CandidateSearch> choices = run_candidate_searches(in, start, before, out);
+  if (choices.size() == 1) return std::move(choices.front());  // nothing to choose between
+  const std::size_t searches = choices.size();
+  if (in.config.average_candidates) {
+    if (auto mean = mean_of_searches(in, choices, before, out)) choices.push_back(std::move(*mean));
+  }
+  std::vector<CandidatesRow> rows;
+  const std::vector<tuning::CandidateScore> scores =
+      score_candidates(in, choices, start, rows, out);
+  std::size_t chosen = tuning::choose_candidate(
+      std::vector<tuning::CandidateScore>(scores.begin(), scores.begin() + searches));
+  if (choices.size() > searches && tuning::keep_mean(scores.back(), scores[chosen])) {
+    chosen = searches;
+  }
   rows[chosen].chosen = true;
   const std::string path = (fs::path(in.run_dir) / "candidates.csv").string();
   try {
@@ -290,8 +345,11 @@ CandidateSearch search_candidates(const FinetuneStageInput& in, const nn::Mlp& s
   } catch (const std::exception& e) {
     out << "auvrl train: could not write " << path << ": " << e.what() << "\n";
   }
-  out << "auvrl train: fine-tuning: candidate " << chosen + 1 << " chosen\n";
-  return std::move(searches[chosen]);
+  out << "auvrl train: fine-tuning: "
+      << (choices[chosen].mean ? std::string("the searches' mean")
+                               : fmt::format("candidate {}", chosen + 1))
+      << " chosen\n";
+  return std::move(choices[chosen]);
 }
 
 }  // namespace
@@ -318,8 +376,10 @@ std::string finetune_stage(const FinetuneStageInput& in, const std::string& star
   }
   const std::string tuned_path = (fs::path(in.run_dir) / "policy_finetuned.nn").string();
   nn::save_network_file(tuned_path, *best.net);
-  out << "  validation after:  " << describe(best.score) << " (iteration " << best.iteration
-      << ")\n"
+  out << "  validation after:  " << describe(best.score)
+      << (search.mean ? std::string(" (the searches' mean)")
+                      : fmt::format(" (iteration {})", best.iteration))
+      << "\n"
       << "  kept: " << tuned_path << "\n";
   report_objective_terms(in, search.result.episodes, start, best.net, out);
   return tuned_path;

@@ -103,6 +103,9 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
   t.field("candidates", &C::candidates, "searches",
           "searches from the trained policy, each with its own seed; the kept one passes the "
           "most criteria at selection_seed (the robustness groups, way-points straight behind)");
+  t.field("average_candidates", &C::average_candidates, "",
+          "with two or more searches that kept weights: their mean is kept unless the search "
+          "chosen among them passes more criteria at selection_seed");
   t.field("candidates_within_s", &C::candidates_within_s, "s, 0: no limit",
           "an asynchronous run starts a further candidate only if it would end within this "
           "many seconds of the training's start, at the pace of those before");

@@ -128,11 +128,18 @@ void write_objective_terms(const std::string& path, const std::vector<ObjectiveT
 }
 
 void write_candidates(const std::string& path, const std::vector<CandidatesRow>& rows) {
-  csv::Writer writer(path, {"candidate", "seed", "kept_iteration", "objective_s", "groups_passing",
-                            "groups", "behind_late", "behind_episodes", "chosen"});
+  csv::Writer writer(
+      path, {"candidate", "weights", "seed", "kept_iteration", "objective_s", "groups_passing",
+             "groups", "behind_late", "behind_episodes", "chosen"});
   for (const CandidatesRow& r : rows) {
-    writer.row(r.candidate, r.seed, r.kept_iteration, r.objective_s, r.groups_passing, r.groups,
-               r.behind_late, r.behind_episodes, r.chosen ? 1 : 0);
+    writer.cell(r.candidate).cell(r.mean ? "mean" : "search");
+    if (r.mean) {
+      writer.empty().empty();
+    } else {
+      writer.cell(r.seed).cell(r.kept_iteration);
+    }
+    writer.row(r.objective_s, r.groups_passing, r.groups, r.behind_late, r.behind_episodes,
+               r.chosen ? 1 : 0);
   }
   writer.flush();
 }

@@ -120,6 +120,7 @@ struct CandidatesRow {
   int behind_late = 0;       ///< way-points straight behind reached late (tuning::CandidateScore)
   int behind_episodes = 0;   ///< of these
   bool chosen = false;       ///< the one kept
+  bool mean = false;  ///< the searches' mean (finetune.average_candidates): no seed or iteration
 };
 
 /// Writes candidates.csv: one row per candidate. Throws std::runtime_error naming the file when

@@ -117,6 +117,10 @@ std::size_t choose_candidate(const std::vector<CandidateScore>& scores) {
   return best;
 }
 
+bool keep_mean(const CandidateScore& mean, const CandidateScore& chosen_search) {
+  return mean.criteria_passing() >= chosen_search.criteria_passing();
+}
+
 int suite_failures(const sim::VehicleModel& model, const task::TaskConfig& task, std::uint64_t seed,
                    const nn::Mlp& policy, int episodes_per_group) {
   require_validation_seed(seed, "the selection");

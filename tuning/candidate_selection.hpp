@@ -78,6 +78,12 @@ class SuiteSelector {
 /// std::invalid_argument when there is none.
 std::size_t choose_candidate(const std::vector<CandidateScore>& scores);
 
+/// Whether the searches' mean weights (finetune.average_candidates) are kept rather than the
+/// search choose_candidate chose: unless that search passes more criteria. Ties go to the mean:
+/// at equal scores on the selection draw the mean passed more groups on validation draws
+/// (docs/lab-notes/2026-12-03-the-searches-mean.md).
+bool keep_mean(const CandidateScore& mean, const CandidateScore& chosen_search);
+
 /// The failures (flips and blow-ups) of the policy, driving as the task says, over the
 /// robustness suite drawn at `seed`: a validation draw of the pipeline's own. Throws
 /// std::invalid_argument when seed is the evaluation's own draw, as SuiteSelector does.

@@ -381,6 +381,20 @@ void soft_update(Mlp& target, const Mlp& source, float tau) {
   target.params() = tau * source.params() + (1.0f - tau) * target.params();
 }
 
+Mlp mean_of(const std::vector<const Mlp*>& nets) {
+  if (nets.empty()) invalid("mean_of: no network");
+  Mlp mean = *nets.front();
+  for (std::size_t i = 1; i < nets.size(); ++i) {
+    if (nets[i]->spec() != mean.spec()) {
+      invalid("mean_of: network " + std::to_string(i + 1) + " " + nets[i]->spec().describe() +
+              " differs from the first " + mean.spec().describe());
+    }
+    mean.params() += nets[i]->params();
+  }
+  mean.params() /= static_cast<float>(nets.size());
+  return mean;
+}
+
 void set_num_threads(int n) { Eigen::setNbThreads(std::max(n, 1)); }
 
 int num_threads() { return Eigen::nbThreads(); }

@@ -409,10 +409,60 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   EXPECT_TRUE(evaluated == policy || evaluated == o.out_dir + "/policy_finetuned.nn") << evaluated;
 }
 
+// The searches' mean (finetune.average_candidates): with thrust priced far above the preset
+// (energy_weight 5), two iterations of each search already rank above the committed policy on
+// the validation way-points, so both keep weights and their mean is a third choice, scored
+// like them; the choice follows tuning::keep_mean, and a mean kept is the mean of the weights
+// the two searches kept, to the bit.
+TEST(RefinetuneTest, TheSearchesMeanIsAChoiceScoredLikeThemAndKeptUnlessASearchPassesMore) {
+  const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
+  RefinetuneOptions o = refinetune_committed_policy(tmp, 2, 2);
+  o.seed = 5;
+  o.keep_iterates = true;
+  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
+  const std::size_t energy = yaml.find("\n  energy_weight: ");
+  ASSERT_NE(energy, std::string::npos);
+  yaml.replace(energy, yaml.find('\n', energy + 1) - energy, "\n  energy_weight: 5");
+  ASSERT_NE(yaml.find("\n  average_candidates: true"), std::string::npos);
+  o.config_path = (tmp / "priced.yaml").string();
+  std::ofstream(o.config_path) << yaml;
+  std::ostringstream out;
+  ASSERT_EQ(refinetune(o, out), 0) << out.str();
+  const auto rows = test_support::read_csv(tmp / "again" / "candidates.csv");
+  ASSERT_EQ(rows.size(), 3u) << out.str();
+  std::vector<tuning::CandidateScore> scores;
+  for (const auto& row : rows) {
+    scores.push_back({std::stoi(row.at("groups_passing")), std::stoi(row.at("behind_late")),
+                      std::stoi(row.at("behind_episodes"))});
+  }
+  EXPECT_EQ(rows[0].at("kept_iteration"), "2");
+  EXPECT_EQ(rows[1].at("kept_iteration"), "2");
+  EXPECT_EQ(rows[2].at("weights"), "mean");
+  EXPECT_EQ(rows[2].at("seed"), "");
+  EXPECT_EQ(rows[2].at("kept_iteration"), "");
+  EXPECT_NE(out.str().find("fine-tuning the mean of candidates 1-2: objective "), std::string::npos)
+      << out.str();
+  std::size_t chosen = tuning::choose_candidate({scores[0], scores[1]});
+  if (tuning::keep_mean(scores[2], scores[chosen])) chosen = 2;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].at("chosen"), i == chosen ? "1" : "0") << i;
+  }
+  if (chosen != 2) return;  // a search passed more criteria: its weights are kept
+  EXPECT_NE(out.str().find("the searches' mean chosen"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("(the searches' mean)"), std::string::npos) << out.str();
+  const nn::Mlp first = nn::network_from_bytes(
+      nn::read_file((tmp / "again" / "iterates" / "iteration_002.nn").string()), 1);
+  const nn::Mlp second = nn::network_from_bytes(
+      nn::read_file((tmp / "again" / "iterates_candidate2" / "iteration_002.nn").string()), 1);
+  EXPECT_EQ(nn::read_file(evaluated_policy(tmp / "again")),
+            nn::network_to_bytes(nn::mean_of({&first, &second})));
+}
+
 // With candidates, each search keeps its own progress file, the seeds follow the run's (the
 // one its command line gave), and the one passing the most criteria at the selection seed
-// (robustness groups, way-points straight behind) is kept (two iterations each: the choice, not the
-// search, is under test).
+// (robustness groups, way-points straight behind) is kept, or the searches' mean where the
+// preset's finetune.average_candidates forms it and tuning::keep_mean keeps it (two iterations
+// each: the choice, not the search, is under test).
 TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   const RefinetuneOptions o = refinetune_committed_policy(tmp, 2, 2);
@@ -422,7 +472,7 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   EXPECT_TRUE(fs::exists(tmp / "again" / "finetune.csv"));
   EXPECT_TRUE(fs::exists(tmp / "again" / "finetune_candidate2.csv"));
   const auto rows = test_support::read_csv(tmp / "again" / "candidates.csv");
-  ASSERT_EQ(rows.size(), 2u) << out.str();
+  ASSERT_TRUE(rows.size() == 2u || rows.size() == 3u) << out.str();
   ASSERT_EQ(rows[0].count("groups_passing"), 1u);
   EXPECT_EQ(rows[0].at("seed"), "4");
   EXPECT_EQ(rows[1].at("seed"), "5");
@@ -432,11 +482,20 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
                       std::stoi(row.at("behind_episodes"))});
     EXPECT_EQ(row.at("behind_episodes"), std::to_string(tuning::kBehindEpisodes));
   }
-  const std::size_t chosen = tuning::choose_candidate(scores);
-  EXPECT_EQ(rows[chosen].at("chosen"), "1");
-  EXPECT_EQ(rows[1 - chosen].at("chosen"), "0");
-  EXPECT_NE(out.str().find(fmt::format("candidate {} chosen", chosen + 1)), std::string::npos)
-      << out.str();
+  std::size_t chosen = tuning::choose_candidate({scores[0], scores[1]});
+  EXPECT_EQ(rows[0].at("weights"), "search");
+  EXPECT_EQ(rows[1].at("weights"), "search");
+  if (rows.size() == 3u) {  // both searches kept weights, and their mean validated above the start
+    EXPECT_EQ(rows[2].at("weights"), "mean");
+    EXPECT_EQ(rows[2].at("seed"), "");
+    if (tuning::keep_mean(scores[2], scores[chosen])) chosen = 2;
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(rows[i].at("chosen"), i == chosen ? "1" : "0") << i;
+  }
+  const std::string said = chosen == 2 ? std::string("the searches' mean chosen")
+                                       : fmt::format("candidate {} chosen", chosen + 1);
+  EXPECT_NE(out.str().find(said), std::string::npos) << out.str();
   // Settings out of range are refused before anything is written.
   RefinetuneOptions too_many = o;
   too_many.out_dir = (tmp / "too_many").string();
@@ -444,7 +503,7 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   std::ostringstream refused;
   EXPECT_THROW(refinetune(too_many, refused), std::invalid_argument);
   EXPECT_FALSE(fs::exists(too_many.out_dir));
-  // The chosen search's weights are the ones evaluated (the trained policy where it kept none).
+  // The chosen weights are the ones evaluated (the trained policy where a search kept none).
   EXPECT_EQ(evaluated_policy(tmp / "again"),
             rows[chosen].at("kept_iteration") == "0" ? policy : o.out_dir + "/policy_finetuned.nn")
       << out.str();

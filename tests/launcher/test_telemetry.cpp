@@ -159,15 +159,18 @@ TEST(TelemetryTest, ObjectiveTermsARowPerControllerEveryPriceInSeconds) {
                std::runtime_error);
 }
 
-TEST(TelemetryTest, CandidatesARowPerSearchTheChosenMarked) {
+TEST(TelemetryTest, CandidatesARowPerSearchAndTheirMeanTheChosenMarked) {
   const fs::path dir = test_support::make_temp_dir("auvrl_telemetry_");
-  write_candidates((dir / "candidates.csv").string(), {{1, 3, 80, 18.75, 21, 25, 15, 100, false},
-                                                       {2, 4, 0, 19.5, 25, 25, 4, 100, true}});
+  write_candidates((dir / "candidates.csv").string(),
+                   {{1, 3, 80, 18.75, 21, 25, 15, 100, false},
+                    {2, 4, 0, 19.5, 25, 25, 4, 100, false},
+                    {3, 0, 0, 18.5, 25, 25, 3, 100, true, true}});
   EXPECT_EQ(slurp(dir / "candidates.csv"),
-            "candidate,seed,kept_iteration,objective_s,groups_passing,groups,behind_late,"
+            "candidate,weights,seed,kept_iteration,objective_s,groups_passing,groups,behind_late,"
             "behind_episodes,chosen\n"
-            "1,3,80,18.75,21,25,15,100,0\n"
-            "2,4,0,19.5,25,25,4,100,1\n");
+            "1,search,3,80,18.75,21,25,15,100,0\n"
+            "2,search,4,0,19.5,25,25,4,100,0\n"
+            "3,mean,,,18.5,25,25,3,100,1\n");
   EXPECT_THROW(write_candidates((dir / "none" / "candidates.csv").string(), {}),
                std::runtime_error);
 }

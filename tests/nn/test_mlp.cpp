@@ -243,6 +243,30 @@ TEST(Mlp, WrongShapesAreRejected) {
   EXPECT_THROW(critic.forward(Matrix::Zero(3, 2), Matrix::Zero(2, 3)), std::invalid_argument);
 }
 
+TEST(Mlp, MeanOfNetworksIsTheMeanOfEachParameter) {
+  Rng rng(6);
+  Mlp a(MlpSpec::actor(3, {8}, 2), 4), b(MlpSpec::actor(3, {8}, 2), 1), c(a);
+  a.init_lillicrap(rng);
+  b.init_lillicrap(rng);
+  c.init_lillicrap(rng);
+  const Mlp mean = mean_of({&a, &b, &c});
+  EXPECT_EQ(mean.spec(), a.spec());
+  EXPECT_EQ(mean.max_batch(), 4);  // the first one's
+  EXPECT_LT((mean.params() - (a.params() + b.params() + c.params()) / 3.0f).cwiseAbs().maxCoeff(),
+            1e-7f);
+  // Two networks: exactly halfway, the same bits as 0.5 a + 0.5 b.
+  EXPECT_EQ(mean_of({&a, &b}).params(), (0.5f * a.params() + 0.5f * b.params()).eval());
+  EXPECT_EQ(mean_of({&a}).params(), a.params());
+  const Mlp other(MlpSpec::actor(3, {9}, 2), 4);
+  try {
+    mean_of({&a, &other});
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("network 2"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(mean_of({}), std::invalid_argument);
+}
+
 TEST(Mlp, SoftUpdateAndCopy) {
   Rng rng(5);
   Mlp a(MlpSpec::actor(3, {8}, 2), 4), b(MlpSpec::actor(3, {8}, 2), 4);

@@ -48,6 +48,17 @@ TEST(CandidateSelection, TheMostCriteriaWinThenFewerLateThenTheEarliest) {
   EXPECT_THROW(choose_candidate({}), std::invalid_argument);
 }
 
+TEST(CandidateSelection, TheMeanIsKeptUnlessTheChosenSearchPassesMoreCriteria) {
+  EXPECT_TRUE(keep_mean(score(25, 0), score(25, 0)));  // level: the mean
+  EXPECT_TRUE(keep_mean(score(25, 8), score(25, 0)));  // level on criteria, more late: still
+  EXPECT_TRUE(keep_mean(score(24, 0), score(23, 0)));
+  EXPECT_FALSE(keep_mean(score(23, 0), score(24, 0)));
+  // The behind criterion counts: 24 + 0 against 24 + 1, and 25 + 0 against 24 + 1 is level.
+  EXPECT_FALSE(keep_mean(score(24, 15), score(24, 2)));
+  EXPECT_TRUE(keep_mean(score(24, 2), score(24, 15)));
+  EXPECT_TRUE(keep_mean(score(25, 15), score(24, 2)));
+}
+
 TEST(SuiteSelector, RefusesTheEvaluationsOwnDraw) {
   try {
     SuiteSelector selector(nessie(), fast_task(), 1, 1);
