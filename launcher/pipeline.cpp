@@ -260,7 +260,7 @@ std::vector<CandidateSearch> run_candidate_searches(const FinetuneStageInput& in
 }
 
 /// The searches' mean as a further choice (finetune.average_candidates): the mean of the
-/// weights the searches kept, validated as they were. None where fewer than two kept weights,
+/// weights the searches kept, validated as they were. None unless every search kept weights,
 /// or where the mean does not rank above the trained policy (`before`) on the validation
 /// way-points, as a search's weights must to be kept.
 std::optional<CandidateSearch> mean_of_searches(const FinetuneStageInput& in,
@@ -269,9 +269,9 @@ std::optional<CandidateSearch> mean_of_searches(const FinetuneStageInput& in,
                                                 std::ostream& out) {
   std::vector<const nn::Mlp*> kept;
   for (const CandidateSearch& c : searches) {
-    if (c.best.net) kept.push_back(&*c.best.net);
+    if (!c.best.net) return std::nullopt;  // the trained policy: nothing of its own to average
+    kept.push_back(&*c.best.net);
   }
-  if (kept.size() < 2) return std::nullopt;
   nn::Mlp mean = nn::mean_of(kept);
   const eval::ValidationScore score =
       in.validation.evaluate(mean, tuning::search_threads(in.config));

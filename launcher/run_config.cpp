@@ -104,7 +104,7 @@ config::Table<tuning::FinetuneConfig> make_finetune_table() {
           "searches from the trained policy, each with its own seed; the kept one passes the "
           "most criteria at selection_seed (the robustness groups, way-points straight behind)");
   t.field("average_candidates", &C::average_candidates, "",
-          "with two or more searches that kept weights: their mean is kept unless the search "
+          "where every search (two or more) kept weights: their mean is kept unless the search "
           "chosen among them passes more criteria at selection_seed");
   t.field("candidates_within_s", &C::candidates_within_s, "s, 0: no limit",
           "an asynchronous run starts a further candidate only if it would end within this "

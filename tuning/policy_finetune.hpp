@@ -126,9 +126,9 @@ struct FinetuneConfig {
   /// those that pass the most criteria at selection_seed: the robustness groups against the PID
   /// and the way-points straight behind (tuning::choose_candidate). 1: one search, no choice.
   int candidates = 1;
-  /// With two or more searches that kept weights: their mean (nn::mean_of) is a further choice,
-  /// scored as they are, and kept unless the search chosen among them passes more criteria
-  /// (tuning::keep_mean).
+  /// Where every search (two or more) kept weights: their mean (nn::mean_of) is a further
+  /// choice, scored as they are, and kept unless the search chosen among them passes more
+  /// criteria (tuning::keep_mean).
   bool average_candidates = false;
   /// An asynchronous run's fine-tuning starts a further candidate only when, at the pace of
   /// those before, it would end within this many seconds of the training's start (its TD3 phase,
