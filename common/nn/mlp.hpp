@@ -167,9 +167,8 @@ class Mlp {
 void soft_update(Mlp& target, const Mlp& source, float tau);
 
 /// The network whose every parameter is the mean of the networks' (a uniform "model soup",
-/// Wortsman et al. 2022: searches from one start end in one basin, where their mean generalises
-/// at least as well as each), with the first one's max_batch. Throws std::invalid_argument when
-/// there is none or their specs differ.
+/// Wortsman et al. 2022, for networks fine-tuned from one start), with the first one's
+/// max_batch. Throws std::invalid_argument when there is none or their specs differ.
 Mlp mean_of(const std::vector<const Mlp*>& nets);
 
 /// Sets how many threads the layer products may use (needs OpenMP; 1 otherwise): large products
