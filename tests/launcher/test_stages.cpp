@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -63,6 +64,34 @@ RefinetuneOptions refinetune_committed_policy(const fs::path& tmp, int iteration
   o.iterations = iterations;
   o.candidates = candidates;
   return o;
+}
+
+/// The fast preset's text with the line of finetune key `key` set to `value`; empty when the
+/// preset has no such line.
+std::string fast_preset_with(const std::string& key, const std::string& value) {
+  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
+  const std::size_t at = yaml.find("\n  " + key + ": ");
+  if (at == std::string::npos) return "";
+  yaml.replace(at, yaml.find('\n', at + 1) - at, "\n  " + key + ": " + value);
+  return yaml;
+}
+
+/// What the choice knows of each row of a candidates.csv.
+std::vector<tuning::CandidateScore> candidate_scores(
+    const std::vector<std::map<std::string, std::string>>& rows) {
+  std::vector<tuning::CandidateScore> scores;
+  for (const auto& row : rows) {
+    scores.push_back({std::stoi(row.at("groups_passing")), std::stoi(row.at("behind_late")),
+                      std::stoi(row.at("behind_episodes"))});
+  }
+  return scores;
+}
+
+/// The row the pipeline must choose among two searches (rows 0 and 1) and, when there is a
+/// third row, their mean: tuning::choose_candidate, then tuning::keep_mean.
+std::size_t expected_choice(const std::vector<tuning::CandidateScore>& scores) {
+  const std::size_t search = tuning::choose_candidate({scores[0], scores[1]});
+  return scores.size() == 3u && tuning::keep_mean(scores[2], scores[search]) ? 2 : search;
 }
 
 /// The policy an output directory's evaluation names (eval/selected_policy.txt).
@@ -385,11 +414,9 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   const fs::path tmp = test_support::make_temp_dir("auvrl_refinetune_");
   RefinetuneOptions o = refinetune_committed_policy(tmp, 5, 2);
   const std::string policy = (tmp / "run" / "policy.nn").string();
-  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
   // The preset's cap replaced by one that the first iteration already passes.
-  const std::size_t own = yaml.find("\n  max_search_s: ");
-  ASSERT_NE(own, std::string::npos);
-  yaml.replace(own, yaml.find('\n', own + 1) - own, "\n  max_search_s: 0.001");
+  const std::string yaml = fast_preset_with("max_search_s", "0.001");
+  ASSERT_FALSE(yaml.empty());
   const fs::path config = tmp / "capped.yaml";
   std::ofstream(config) << yaml;
   o.config_path = config.string();
@@ -419,10 +446,8 @@ TEST(RefinetuneTest, TheSearchesMeanIsAChoiceScoredLikeThemAndKeptUnlessASearchP
   RefinetuneOptions o = refinetune_committed_policy(tmp, 2, 2);
   o.seed = 5;
   o.keep_iterates = true;
-  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
-  const std::size_t energy = yaml.find("\n  energy_weight: ");
-  ASSERT_NE(energy, std::string::npos);
-  yaml.replace(energy, yaml.find('\n', energy + 1) - energy, "\n  energy_weight: 5");
+  const std::string yaml = fast_preset_with("energy_weight", "5");
+  ASSERT_FALSE(yaml.empty());
   ASSERT_NE(yaml.find("\n  average_candidates: true"), std::string::npos);
   o.config_path = (tmp / "priced.yaml").string();
   std::ofstream(o.config_path) << yaml;
@@ -430,11 +455,6 @@ TEST(RefinetuneTest, TheSearchesMeanIsAChoiceScoredLikeThemAndKeptUnlessASearchP
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
   const auto rows = test_support::read_csv(tmp / "again" / "candidates.csv");
   ASSERT_EQ(rows.size(), 3u) << out.str();
-  std::vector<tuning::CandidateScore> scores;
-  for (const auto& row : rows) {
-    scores.push_back({std::stoi(row.at("groups_passing")), std::stoi(row.at("behind_late")),
-                      std::stoi(row.at("behind_episodes"))});
-  }
   EXPECT_EQ(rows[0].at("kept_iteration"), "2");
   EXPECT_EQ(rows[1].at("kept_iteration"), "2");
   EXPECT_EQ(rows[2].at("weights"), "mean");
@@ -442,8 +462,7 @@ TEST(RefinetuneTest, TheSearchesMeanIsAChoiceScoredLikeThemAndKeptUnlessASearchP
   EXPECT_EQ(rows[2].at("kept_iteration"), "");
   EXPECT_NE(out.str().find("fine-tuning the mean of candidates 1-2: objective "), std::string::npos)
       << out.str();
-  std::size_t chosen = tuning::choose_candidate({scores[0], scores[1]});
-  if (tuning::keep_mean(scores[2], scores[chosen])) chosen = 2;
+  const std::size_t chosen = expected_choice(candidate_scores(rows));
   for (std::size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(rows[i].at("chosen"), i == chosen ? "1" : "0") << i;
   }
@@ -476,19 +495,15 @@ TEST(RefinetuneTest, CandidatesSearchFromTheRunsSeedAndTheMostGroupsAreKept) {
   ASSERT_EQ(rows[0].count("groups_passing"), 1u);
   EXPECT_EQ(rows[0].at("seed"), "4");
   EXPECT_EQ(rows[1].at("seed"), "5");
-  std::vector<tuning::CandidateScore> scores;
   for (const auto& row : rows) {
-    scores.push_back({std::stoi(row.at("groups_passing")), std::stoi(row.at("behind_late")),
-                      std::stoi(row.at("behind_episodes"))});
     EXPECT_EQ(row.at("behind_episodes"), std::to_string(tuning::kBehindEpisodes));
   }
-  std::size_t chosen = tuning::choose_candidate({scores[0], scores[1]});
+  const std::size_t chosen = expected_choice(candidate_scores(rows));
   EXPECT_EQ(rows[0].at("weights"), "search");
   EXPECT_EQ(rows[1].at("weights"), "search");
   if (rows.size() == 3u) {  // both searches kept weights, and their mean validated above the start
     EXPECT_EQ(rows[2].at("weights"), "mean");
     EXPECT_EQ(rows[2].at("seed"), "");
-    if (tuning::keep_mean(scores[2], scores[chosen])) chosen = 2;
   }
   for (std::size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(rows[i].at("chosen"), i == chosen ? "1" : "0") << i;
