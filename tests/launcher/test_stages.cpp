@@ -66,14 +66,18 @@ RefinetuneOptions refinetune_committed_policy(const fs::path& tmp, int iteration
   return o;
 }
 
-/// The fast preset's text with the line of finetune key `key` set to `value`; empty when the
-/// preset has no such line.
-std::string fast_preset_with(const std::string& key, const std::string& value) {
-  std::string yaml = test_support::read_text(std::string(AUVRL_CONFIG_DIR) + "/presets/fast.yaml");
-  const std::size_t at = yaml.find("\n  " + key + ": ");
-  if (at == std::string::npos) return "";
-  yaml.replace(at, yaml.find('\n', at + 1) - at, "\n  " + key + ": " + value);
-  return yaml;
+/// Writes the fast preset to `path` (test_support::write_preset_copy) with the first line of
+/// finetune key `key` set to `value`; false when the preset has no such line.
+bool write_fast_preset_with(const fs::path& path, const std::string& key,
+                            const std::string& value) {
+  const std::string prefix = "  " + key + ": ";
+  bool edited = false;
+  test_support::write_preset_copy(AUVRL_CONFIG_DIR, "fast", path.string(), [&](std::string& line) {
+    if (edited || line.rfind(prefix, 0) != 0) return;
+    line = prefix + value;
+    edited = true;
+  });
+  return edited;
 }
 
 /// What the choice knows of each row of a candidates.csv.
@@ -415,10 +419,8 @@ TEST(RefinetuneTest, ASearchPastTheCapEndsValidatedAndKeepsItsBest) {
   RefinetuneOptions o = refinetune_committed_policy(tmp, 5, 2);
   const std::string policy = (tmp / "run" / "policy.nn").string();
   // The preset's cap replaced by one that the first iteration already passes.
-  const std::string yaml = fast_preset_with("max_search_s", "0.001");
-  ASSERT_FALSE(yaml.empty());
   const fs::path config = tmp / "capped.yaml";
-  std::ofstream(config) << yaml;
+  ASSERT_TRUE(write_fast_preset_with(config, "max_search_s", "0.001"));
   o.config_path = config.string();
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
@@ -446,11 +448,10 @@ TEST(RefinetuneTest, TheSearchesMeanIsAChoiceScoredLikeThemAndKeptUnlessASearchP
   RefinetuneOptions o = refinetune_committed_policy(tmp, 2, 2);
   o.seed = 5;
   o.keep_iterates = true;
-  const std::string yaml = fast_preset_with("energy_weight", "5");
-  ASSERT_FALSE(yaml.empty());
-  ASSERT_NE(yaml.find("\n  average_candidates: true"), std::string::npos);
   o.config_path = (tmp / "priced.yaml").string();
-  std::ofstream(o.config_path) << yaml;
+  ASSERT_TRUE(write_fast_preset_with(o.config_path, "energy_weight", "5"));
+  ASSERT_NE(test_support::read_text(o.config_path).find("\n  average_candidates: true"),
+            std::string::npos);
   std::ostringstream out;
   ASSERT_EQ(refinetune(o, out), 0) << out.str();
   const auto rows = test_support::read_csv(tmp / "again" / "candidates.csv");
