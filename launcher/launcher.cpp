@@ -21,7 +21,8 @@ int run_training(const TrainOptions& options, std::ostream& out) {
     return trained.exit_code;
   }
   const std::optional<std::string> selected = select_policy(
-      ctx.run_dir, *trained.best, {ctx.model, ctx.rc.task, ctx.rc.finetune.selection_seed}, out);
+      ctx.run_dir, *trained.best, {ctx.model, ctx.rc.task, ctx.rc.finetune.selection_seed},
+      ctx.rc.learner_average_window_updates > 0, out);
   if (!selected) {
     out << "auvrl train: no policy was written; nothing to fine-tune or evaluate\n";
     return 1;

@@ -62,8 +62,11 @@ std::string fewer_failures(const std::string& preferred, const std::string& othe
 
 }  // namespace
 
-std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best,
-                                         const SelectionDraw& draw, std::ostream& out) {
+namespace {
+
+/// policy.nn or policy_best.nn, as select_policy says without the average.
+std::optional<std::string> select_trained(const std::string& run_dir, const BestPolicyKeeper& best,
+                                          const SelectionDraw& draw, std::ostream& out) {
   const std::string last = (fs::path(run_dir) / "policy.nn").string();
   if (!fs::exists(best.best_path())) {
     if (!fs::exists(last)) return std::nullopt;
@@ -78,6 +81,18 @@ std::optional<std::string> select_policy(const std::string& run_dir, const BestP
   }
   const std::string preferred = best_above ? best.best_path() : last;
   return fewer_failures(preferred, best_above ? last : best.best_path(), draw, out);
+}
+
+}  // namespace
+
+std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best,
+                                         const SelectionDraw& draw, bool average,
+                                         std::ostream& out) {
+  const std::optional<std::string> trained = select_trained(run_dir, best, draw, out);
+  const fs::path mean = fs::path(run_dir) / kAveragePolicyFile;
+  if (!average || !fs::is_regular_file(mean)) return trained;
+  if (!trained) return mean.string();
+  return fewer_failures(mean.string(), *trained, draw, out);
 }
 
 namespace {

@@ -29,9 +29,12 @@ struct SelectionDraw {
 /// above the last one on the quick evaluation (or the last one cannot be read); but of two
 /// different files, the one with fewer failures (flips, blow-ups) on the selection draw, which
 /// the quick evaluation's few way-points can miss (a TD3 snapshot that flips on deep dives).
-/// Says what it counted on out. Nothing when neither file exists.
+/// Says what it counted on out. Nothing when neither file exists. With `average` (the run sets
+/// learner.average_window_updates) and the learner's mean of its recent actors written
+/// (kAveragePolicyFile): the mean, unless that choice has fewer failures on the same draw.
 std::optional<std::string> select_policy(const std::string& run_dir, const BestPolicyKeeper& best,
-                                         const SelectionDraw& draw, std::ostream& out);
+                                         const SelectionDraw& draw, bool average,
+                                         std::ostream& out);
 
 /// What the fine-tuning stage needs besides the policy.
 struct FinetuneStageInput {

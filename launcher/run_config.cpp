@@ -141,6 +141,7 @@ RunConfig read_run_config(const std::string& path) {
   config::Section learner = root.child("learner");
   learner.read("max_episodes", c.learner_max_episodes);
   learner.read("max_updates", c.learner_max_updates);
+  learner.read("average_window_updates", c.learner_average_window_updates);
   config::Section run = root.child("run");
   run_table().read_keys(run, c.run);
   if (!(c.run.best_eval_max_hold_m > 0.0)) {

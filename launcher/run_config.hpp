@@ -1,6 +1,6 @@
 // The run configuration as the launcher reads it: the `run:` section (its own), and what it
-// needs of the others (vehicle, task, learner.max_episodes and max_updates, transport,
-// finetune).
+// needs of the others (vehicle, task, learner.max_episodes, max_updates and
+// average_window_updates, transport, finetune).
 #pragma once
 
 #include <cstdint>
@@ -59,8 +59,11 @@ struct RunConfig {
   std::string vehicle_path;
   std::int64_t learner_max_episodes = 0;  ///< learner.max_episodes (0: never)
   std::int64_t learner_max_updates = 0;   ///< learner.max_updates (0: never)
-  transport::TransportConfig transport;   ///< the `transport:` section (LCM by default)
-  tuning::FinetuneConfig finetune;        ///< the `finetune:` section (off by default)
+  /// learner.average_window_updates (0: off): the learner writes RUN/policy_average.nn, the
+  /// policy that goes on.
+  std::int64_t learner_average_window_updates = 0;
+  transport::TransportConfig transport;  ///< the `transport:` section (LCM by default)
+  tuning::FinetuneConfig finetune;       ///< the `finetune:` section (off by default)
 };
 
 /// Reads and checks a run configuration; throws config::ConfigError naming file, key and line.

@@ -72,6 +72,8 @@ void write_readme(const std::string& run_dir) {
         << "  logs/             LCM event logs of all traffic (auv_log list logs/*.lcmlog)\n"
         << "  checkpoints/      learner checkpoints (auvrl train --resume " << run_dir << ")\n"
         << "  policy.nn         the last policy; policy_best.nn: the best by quick evaluation\n"
+        << "  policy_average.nn the mean of the last learner.average_window_updates' actors\n"
+           "                    (when set: the policy that goes on unless it flips more)\n"
         << "  policy_finetuned.nn, finetune.csv   the fine-tuned policy and its progress\n"
         << "  finetune_start.txt   the policy the fine-tuning started from (auvrl finetune\n"
            "                    --run-dir starts there again)\n"

@@ -22,7 +22,8 @@ std::vector<std::string> sign_policies(const std::string& dir, const std::string
                                        std::ostream& out) {
   std::vector<std::string> signed_files;
   try {
-    for (const char* name : {"policy.nn", "policy_best.nn", "policy_finetuned.nn"}) {
+    for (const char* name :
+         {"policy.nn", "policy_best.nn", "policy_average.nn", "policy_finetuned.nn"}) {
       const std::string path = (fs::path(dir) / name).string();
       if (!fs::exists(path)) continue;
       signature::sign_file(path, key_path);

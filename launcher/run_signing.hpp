@@ -12,10 +12,10 @@ namespace auvrl::launcher {
 /// private key's path. Throws std::runtime_error naming the file that cannot be written.
 std::string ensure_run_key(const std::string& run_dir);
 
-/// Signs each of policy.nn, policy_best.nn and policy_finetuned.nn that `dir` holds with the
-/// private key `key_path` (FILE.sig beside it) and says so on `out`. A failure is reported on
-/// `out` and signs nothing more: the policies themselves are never touched. Returns the
-/// policies signed.
+/// Signs each of policy.nn, policy_best.nn, policy_average.nn and policy_finetuned.nn that `dir`
+/// holds with the private key `key_path` (FILE.sig beside it) and says so on `out`. A failure is
+/// reported on `out` and signs nothing more: the policies themselves are never touched. Returns
+/// the policies signed.
 std::vector<std::string> sign_policies(const std::string& dir, const std::string& key_path,
                                        std::ostream& out);
 

@@ -150,14 +150,15 @@ std::vector<std::string> learner_schedule_args(const RunContext& ctx) {
 
 /// The learner's command line (pinned to run.learner_cpu when set).
 std::vector<std::string> learner_argv(const RunContext& ctx, const std::string& bin) {
-  std::vector<std::string> argv = {bin + "auv_learner", "--config", ctx.config_path,
-                                   "--checkpoint-dir",
-                                   (fs::path(ctx.run_dir) / "checkpoints").string(), "--policy-out",
-                                   (fs::path(ctx.run_dir) / "policy.nn").string(), "--max-actors",
-                                   std::to_string(std::max(ctx.actors, 1)),
-                                   // The run's seed also seeds the networks, the minibatches
-                                   // and TD3's noise.
-                                   "--seed", std::to_string(ctx.rc.run.seed)};
+  std::vector<std::string> argv = {
+      bin + "auv_learner", "--config", ctx.config_path, "--checkpoint-dir",
+      (fs::path(ctx.run_dir) / "checkpoints").string(), "--policy-out",
+      (fs::path(ctx.run_dir) / "policy.nn").string(), "--average-policy-out",
+      (fs::path(ctx.run_dir) / kAveragePolicyFile).string(), "--max-actors",
+      std::to_string(std::max(ctx.actors, 1)),
+      // The run's seed also seeds the networks, the minibatches
+      // and TD3's noise.
+      "--seed", std::to_string(ctx.rc.run.seed)};
   argv = concat(argv, learner_schedule_args(ctx));
   if (ctx.rc.run.learner_cpu >= 0 && ctx.rc.run.learner_cpu < ctx.cpus) {
     argv.insert(argv.begin(), {"/usr/bin/taskset", "-c", std::to_string(ctx.rc.run.learner_cpu)});

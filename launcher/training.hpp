@@ -50,6 +50,10 @@ void apply_train_options(const TrainOptions& options, RunConfig& rc);
 /// it has neither. Nothing for an asynchronous run.
 void check_reproducible_budget(const RunConfig& rc);
 
+/// Where the learner writes the mean of its recent actors (learner.average_window_updates), in
+/// the run directory.
+inline constexpr const char* kAveragePolicyFile = "policy_average.nn";
+
 /// Where the learner writes its snapshots in reproducible mode: <run_dir>/snapshots.
 std::string snapshot_dir(const std::string& run_dir);
 

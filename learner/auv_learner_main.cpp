@@ -46,6 +46,9 @@ int main(int argc, char** argv) {
   cmd.option("hidden", &options.hidden, "hidden sizes of both networks, e.g. 400-300");
   cmd.option("checkpoint-dir", &config.checkpoint_dir, "where checkpoints go");
   cmd.option("policy-out", &config.policy_path, "actor network written here at the end");
+  cmd.option("average-policy-out", &config.average_policy_path,
+             "the mean of the actor's last learner.average_window_updates updates written here at "
+             "the end");
   add_reproducible_options(cmd, &config.reproducible, &config.round_weights_every_steps);
   cmd.option("snapshot-dir", &config.snapshot_dir,
              "reproducible mode: the actor network is written here every --snapshot-every-updates");

@@ -87,6 +87,12 @@ config::Table<LearnerNodeConfig> make_learner_table() {
           "updates between checkpoints (reproducible mode)")
       .range(0);
   t.field("keep_checkpoints", &C::keep_checkpoints, "", "checkpoints kept");
+  t.field("average_window_updates", &C::average_window_updates, "updates, 0: off",
+          "the mean of the actor over its last this many updates is written beside the policy")
+      .range(0);
+  t.field("average_every_updates", &C::average_every_updates, "updates",
+          "updates between the copies of the actor that mean is taken over")
+      .range(1);
   t.field("her", &C::her, "", "hindsight relabelling (future strategy) with the task's reward");
   t.field("her_k", &C::her_k, "", "HER: future goals per real one");
   return t;
@@ -108,6 +114,7 @@ void read_learner_section(config::Section s, LearnerNodeConfig& c) {
   learner_table().read(s, c);
   try {
     c.ddpg.validate();
+    [[maybe_unused]] const WeightAverage window(c.average_every_updates, c.average_window_updates);
   } catch (const std::invalid_argument& e) {
     throw config::ConfigError(fmt::format("{}: learner: {}", s.file(), e.what()));
   }

@@ -7,6 +7,7 @@
 #include <auvrl_lcm/policy_summary_t.hpp>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "common/channels.hpp"
 #include "common/nn/serialize.hpp"
@@ -34,7 +35,7 @@ bool all_finite(const std::vector<std::vector<float>>& rows) {
 
 /// Record of the learner's own state in a checkpoint (the algorithm and the buffer follow it).
 constexpr const char* kCheckpointMagic = "AUVRLCK";
-constexpr std::uint32_t kCheckpointVersion = 2;
+constexpr std::uint32_t kCheckpointVersion = 3;
 
 }  // namespace
 
@@ -43,6 +44,7 @@ LearnerNode::LearnerNode(LearnerNodeConfig config, transport::Transport& transpo
     : config_(std::move(config)),
       transport_(transport),
       log_(log),
+      average_(config_.average_every_updates, config_.average_window_updates),
       sample_rng_(config_.ddpg.seed ^ 0x5851F42D4C957F2Dull),
       batch_(config_.ddpg.state_dim, config_.ddpg.action_dim,
              std::max(1, config_.ddpg.batch_size)) {
@@ -268,6 +270,7 @@ void LearnerNode::update_once() {
   } else {
     stats = ddpg_->update(*replay_);
   }
+  average_.observe(ddpg_->updates(), ddpg_->actor());
   ++interval_updates_;
   interval_critic_loss_ += stats.critic_loss;
   interval_actor_loss_ += stats.actor_loss;
@@ -537,6 +540,7 @@ void LearnerNode::save(nn::Writer& w) const {
     w.u64(static_cast<std::uint64_t>(counters_.rounds));
     round_weights_.save(w);
   }
+  average_.save(w);  // version 3
 }
 
 std::string LearnerNode::checkpoint() {
@@ -564,8 +568,8 @@ void LearnerNode::resume() {
         // Everything is read into new objects first: a damaged file changes nothing.
         r.expect_magic(kCheckpointMagic);
         const std::uint32_t version = r.u32();
-        if (version != kCheckpointVersion && version != 1) {
-          r.fail("format version " + std::to_string(version) + ", expected 1 or " +
+        if (version < 1 || version > kCheckpointVersion) {
+          r.fail("format version " + std::to_string(version) + ", expected 1 to " +
                  std::to_string(kCheckpointVersion));
         }
         const auto episodes = static_cast<std::int64_t>(r.u64());
@@ -590,6 +594,9 @@ void LearnerNode::resume() {
         }
         RoundState round;
         if (reproducible) round = read_round_state(r);
+        // Before version 3 no recent weights were kept: the mean starts afresh.
+        WeightAverage average(config_.average_every_updates, config_.average_window_updates);
+        if (version >= 3) average.restore(r, ddpg->actor().num_params());
         r.verify_checksum();
         ddpg_ = std::move(ddpg);
         replay_ = std::move(replay);
@@ -601,6 +608,7 @@ void LearnerNode::resume() {
         seqs.resize(static_cast<std::size_t>(config_.max_actors), -1);
         last_batch_seq_ = std::move(seqs);
         sample_rng_ = sample_rng;
+        average_ = std::move(average);
         if (her_) her_->rebuild(*replay_);
       },
       log_);
@@ -644,8 +652,27 @@ void LearnerNode::finish() {
       log_ << "auv_learner: cannot write the policy: " << e.what() << "\n";
     }
   }
+  write_average_policy();
   publish_weights();
   publish_stats();
+}
+
+void LearnerNode::write_average_policy() {
+  if (config_.average_policy_path.empty() || !average_.enabled()) return;
+  const std::optional<nn::Mlp> mean = average_.mean(ddpg_->actor());
+  if (!mean) {
+    log_ << "auv_learner: no weight average: training ended before update "
+         << config_.average_every_updates << "\n";
+    return;
+  }
+  try {
+    nn::save_network_file(config_.average_policy_path, *mean);
+    log_ << "auv_learner: mean of " << average_.copies() << " actors (updates "
+         << average_.first_updates() << " to " << average_.last_updates() << ") written to "
+         << config_.average_policy_path << "\n";
+  } catch (const std::exception& e) {
+    log_ << "auv_learner: cannot write the weight average: " << e.what() << "\n";
+  }
 }
 
 }  // namespace auvrl::learner

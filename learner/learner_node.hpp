@@ -23,6 +23,7 @@
 #include "learner/hindsight.hpp"
 #include "learner/replay_buffer.hpp"
 #include "learner/rounds.hpp"
+#include "learner/weight_average.hpp"
 
 namespace auvrl::learner {
 
@@ -78,6 +79,13 @@ struct LearnerNodeConfig {
   /// every snapshot_every_updates updates (the launcher's choice of the best policy).
   std::string snapshot_dir;
   std::int64_t snapshot_every_updates = 0;
+
+  /// The uniform mean of the actor over its last average_window_updates updates (a copy every
+  /// average_every_updates; learner/weight_average.hpp), written by finish() to
+  /// average_policy_path. Window 0 or no path: none.
+  std::int64_t average_every_updates = 5000;
+  std::int64_t average_window_updates = 0;
+  std::string average_policy_path;
 };
 
 /// The keys of a `learner:` section: ddpg_table() and the node's own (learner_config.cpp).
@@ -130,6 +138,8 @@ class LearnerNode {
   double beta_m() const { return config_.schedule.beta_m(counters_.episodes); }
   const ReplayBuffer& replay() const { return *replay_; }
   const Ddpg& algorithm() const { return *ddpg_; }
+  /// The actor's recent weights, whose mean finish() writes to average_policy_path.
+  const WeightAverage& weight_average() const { return average_; }
   LearnerCounters counters() const;
 
   /// The policy_weights_t for the current actor network.
@@ -178,6 +188,8 @@ class LearnerNode {
   void publish_weights();
   void publish_stats();
   void save(nn::Writer& w) const;
+  /// Writes the mean of the actor's recent weights to average_policy_path (when configured).
+  void write_average_policy();
 
   LearnerNodeConfig config_;
   transport::Transport& transport_;
@@ -185,6 +197,7 @@ class LearnerNode {
   std::unique_ptr<Ddpg> ddpg_;
   std::unique_ptr<ReplayBuffer> replay_;
   std::unique_ptr<HindsightRelabeler> her_;
+  WeightAverage average_;
   nn::Rng sample_rng_;  ///< minibatches when relabelling (otherwise the algorithm samples)
   Batch batch_;
   LearnerCounters counters_;

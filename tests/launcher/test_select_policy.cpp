@@ -2,7 +2,8 @@
 // the one with fewer flips and blow-ups on the selection draw of the robustness suite, even
 // where the quick evaluation ranks the other above it. The pair in data/ is a real one: an
 // asynchronous run of the fast preset (`auvrl train --seed 3`, 2026-11-29) whose kept snapshot
-// (234350 updates) flips on deep dives and whose last weights do not.
+// (234350 updates) flips on deep dives and whose last weights do not. With weight averaging
+// (learner.average_window_updates) the learner's mean goes on unless that one fails less.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -56,7 +57,8 @@ TEST_F(SelectPolicyTest, FewerFailuresOnTheSelectionDrawWinOverTheQuickEvaluatio
   // The quick evaluation's few way-points rank the flipping snapshot above the last weights.
   ASSERT_TRUE(kept.best_ranks_above((run_ / "policy.nn").string()));
   std::ostringstream out;
-  const auto selected = select_policy(run_.string(), kept, draw(rc_.finetune.selection_seed), out);
+  const auto selected =
+      select_policy(run_.string(), kept, draw(rc_.finetune.selection_seed), false, out);
   ASSERT_TRUE(selected);
   EXPECT_EQ(*selected, (run_ / "policy.nn").string()) << out.str();
   EXPECT_NE(out.str().find("selected policy.nn: flips and blow-ups in the robustness suite at "
@@ -70,7 +72,7 @@ TEST_F(SelectPolicyTest, TheSameWeightsAreNotCountedAndTheEvaluationsDrawIsRefus
     const BestPolicyKeeper kept =
         keeper(kData + "async_seed3_best.nn", kData + "async_seed3_best.nn");
     std::ostringstream out;
-    const auto selected = select_policy(run_.string(), kept, draw(7890), out);
+    const auto selected = select_policy(run_.string(), kept, draw(7890), false, out);
     ASSERT_TRUE(selected);
     EXPECT_EQ(out.str(), "");  // one policy: nothing to count
   }
@@ -78,12 +80,45 @@ TEST_F(SelectPolicyTest, TheSameWeightsAreNotCountedAndTheEvaluationsDrawIsRefus
   const BestPolicyKeeper kept =
       keeper(kData + "async_seed3_last.nn", kData + "async_seed3_best.nn");
   std::ostringstream out;
-  const auto selected = select_policy(run_.string(), kept, draw(1), out);
+  const auto selected = select_policy(run_.string(), kept, draw(1), false, out);
   ASSERT_TRUE(selected);
   // Seed 1 is the evaluation's own draw: not counted there; the quick evaluation's choice stays.
   EXPECT_EQ(*selected, kept.best_path());
   EXPECT_NE(out.str().find("failures not counted"), std::string::npos) << out.str();
   EXPECT_NE(out.str().find("evaluation's own draw"), std::string::npos) << out.str();
+}
+
+TEST_F(SelectPolicyTest, TheWeightAverageGoesOnUnlessItFailsMoreOnTheSelectionDraw) {
+  const BestPolicyKeeper kept =
+      keeper(kData + "async_seed3_last.nn", kData + "async_seed3_best.nn");
+  {
+    std::ostringstream out;  // averaging on, but no average written (a short run): as before
+    const auto selected = select_policy(run_.string(), kept, draw(7890), true, out);
+    ASSERT_TRUE(selected);
+    EXPECT_EQ(*selected, (run_ / "policy.nn").string()) << out.str();
+  }
+  // A mean that flips where the last weights do not: the last weights.
+  fs::copy_file(kData + "async_seed3_best.nn", run_ / kAveragePolicyFile);
+  {
+    std::ostringstream out;
+    const auto selected = select_policy(run_.string(), kept, draw(7890), true, out);
+    ASSERT_TRUE(selected);
+    EXPECT_EQ(*selected, (run_ / "policy.nn").string());
+    EXPECT_NE(out.str().find("selected policy.nn: flips and blow-ups in the robustness suite at "
+                             "seed 7890: policy_average.nn 6, policy.nn 0"),
+              std::string::npos)
+        << out.str();
+  }
+  // A mean that fails no more often: the mean.
+  fs::copy_file(kData + "async_seed3_last.nn", run_ / kAveragePolicyFile,
+                fs::copy_options::overwrite_existing);
+  std::ostringstream out;
+  const auto selected = select_policy(run_.string(), kept, draw(7890), true, out);
+  ASSERT_TRUE(selected);
+  EXPECT_EQ(*selected, (run_ / kAveragePolicyFile).string()) << out.str();
+  std::ostringstream off;  // averaging off: a stale file from another configuration is not used
+  EXPECT_EQ(*select_policy(run_.string(), kept, draw(7890), false, off),
+            (run_ / "policy.nn").string());
 }
 
 }  // namespace

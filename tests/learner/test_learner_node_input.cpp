@@ -3,7 +3,8 @@
 // expert labels, too many or no transitions, unknown actor ids, and episode reports from unknown
 // actors are dropped and counted; nothing of them reaches the replay buffer, the updates or the
 // schedule. Sound experience of other sizes (an actor of another vehicle) stops the learner.
-// LEARNER_STATS carries the smoothness terms' values.
+// LEARNER_STATS carries the smoothness terms' values. The mean of the actor's recent weights
+// survives a checkpoint.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -11,10 +12,13 @@
 #include <auvrl_lcm/experience_batch_t.hpp>
 #include <auvrl_lcm/learner_stats_t.hpp>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 
+#include "child_process.hpp"
 #include "common/channels.hpp"
+#include "common/nn/serialize.hpp"
 #include "common/unrecoverable.hpp"
 #include "learner/learner_node.hpp"
 #include "sim/vehicle_model.hpp"
@@ -227,6 +231,39 @@ TEST_F(LearnerNodeInput, StatsReportTheSmoothnessTerms) {
   ASSERT_FALSE(stats.empty());
   EXPECT_GT(stats.back().smooth_temporal, 0.0);
   EXPECT_EQ(stats.back().smooth_spatial, 0.0);
+}
+
+// The mean of the actor's recent weights is kept in the checkpoint (a resumed learner's mean
+// is the one it would have had) and written beside the policy at the end.
+TEST_F(LearnerNodeInput, TheWeightAverageSurvivesACheckpointAndIsWrittenAtTheEnd) {
+  const std::string dir = test_support::make_temp_dir("auvrl_average_");
+  config_.her = false;
+  config_.checkpoint_dir = dir + "/checkpoints";
+  config_.average_every_updates = 10;
+  config_.average_window_updates = 40;
+  config_.average_policy_path = dir + "/policy_average.nn";
+  node_.reset();
+  node_ = std::make_unique<learner::LearnerNode>(config_, *transport_, log_);
+  for (int i = 0; i < 4; ++i) send(channels::kExperience, batch(40));
+  for (int i = 0; i < 50; ++i) node_->poll(0);
+  ASSERT_GE(node_->updates(), 60);
+  const learner::WeightAverage& average = node_->weight_average();
+  EXPECT_EQ(average.copies(), 4u);
+  EXPECT_EQ(average.last_updates(), node_->updates() / 10 * 10);
+  const nn::Mlp mean = *average.mean(node_->algorithm().actor());
+  EXPECT_NE(mean.params(), node_->algorithm().actor().params());  // a mean, not the last one
+  ASSERT_NE(node_->checkpoint(), "");
+
+  learner::LearnerNode resumed(config_, *transport_, log_);
+  resumed.resume();
+  EXPECT_EQ(resumed.weight_average().copies(), 4u);
+  EXPECT_EQ(resumed.weight_average().first_updates(), average.first_updates());
+  resumed.finish();
+  nn::Mlp written = mean;
+  nn::load_network_file(config_.average_policy_path, written);
+  EXPECT_EQ(written.params(), mean.params());
+  EXPECT_NE(log_.str().find("mean of 4 actors"), std::string::npos) << log_.str();
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
